@@ -1,0 +1,129 @@
+"""The spectral radiance of one scene under one condition: the value the store hands
+to a camera.
+
+A scene is a stack of :class:`RadianceLayer` s: the first (the *plate*) covers the
+whole reference field of view at the collection's reference sampling; the later ones
+(*insets*) cover smaller windows around the car at a finer angular sampling and are
+pasted over the plate. :meth:`SpectralScene.resample` turns the stack into a single
+uniform grid of any size (e.g. a camera's pixel grid) by exact area overlap, so
+radiance (and hence flux) is conserved whatever the two samplings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
+
+
+@dataclass(frozen=True)
+class RadianceLayer:
+    """Spectral radiance on a uniform grid over a rectangle of the image plane.
+
+    Attributes:
+        radiance: float32 array (rows, cols, bands), W·sr⁻¹·m⁻²·nm⁻¹.
+        extent: the rectangle the grid covers, in tangent coordinates (x right, y down).
+    """
+
+    radiance: np.ndarray
+    extent: TanExtent
+
+    @property
+    def pixel_tan(self) -> tuple[float, float]:
+        """Angular sampling (tangent units ≈ radians near the axis) per pixel, (x, y)."""
+        rows, cols = self.radiance.shape[:2]
+        return (self.extent.width / cols, self.extent.height / rows)
+
+
+@dataclass(frozen=True)
+class SpectralScene:
+    """One scene's spectral radiance, ready for a camera.
+
+    Attributes:
+        layers: plate first, then insets (pasted in order).
+        wavelengths_nm: band centres, nm.
+        units: radiance units (always ``W sr-1 m-2 nm-1``).
+        metadata: free-form facts (scene id, condition, distance_m, ...).
+    """
+
+    layers: tuple[RadianceLayer, ...]
+    wavelengths_nm: np.ndarray = field(default_factory=lambda: WAVELENGTHS_NM.copy())
+    units: str = RADIANCE_UNITS
+    metadata: dict = field(default_factory=dict)
+
+    @property
+    def extent(self) -> TanExtent:
+        return self.layers[0].extent
+
+    @classmethod
+    def uniform(
+        cls, spectral_radiance: np.ndarray, rows: int = 8, cols: int = 8, **metadata
+    ) -> "SpectralScene":
+        """A spatially uniform field over the reference field of view (for tests and
+        calibration): ``spectral_radiance`` (bands,) in W·sr⁻¹·m⁻²·nm⁻¹."""
+        spectrum = np.asarray(spectral_radiance, dtype=np.float32)
+        cube = np.broadcast_to(spectrum, (rows, cols, spectrum.size)).copy()
+        return cls(layers=(RadianceLayer(cube, REFERENCE_EXTENT),), metadata=metadata)
+
+    def resample(self, cols: int, rows: int, extent: TanExtent | None = None) -> np.ndarray:
+        """Composite the layers onto a uniform (rows, cols, bands) float32 grid.
+
+        Each output pixel is the area-weighted mean of the layer pixels it overlaps
+        (exact box resampling), so a uniform field stays uniform and flux is
+        conserved. ``extent`` defaults to the plate's (the full field of view).
+        """
+        extent = extent or self.extent
+        out = _resample_layer(self.layers[0], cols, rows, extent)
+        for inset in self.layers[1:]:
+            wx = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
+                                 extent.x0, extent.x1, cols)
+            wy = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
+                                 extent.y0, extent.y1, rows)
+            coverage = np.outer(np.asarray(wy.sum(axis=1)).ravel(), np.asarray(wx.sum(axis=1)).ravel())
+            pasted = _apply(wy, wx, inset.radiance)
+            out = out * (1.0 - coverage[..., None]).astype(np.float32) + pasted
+        return out
+
+
+def _resample_layer(layer: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> np.ndarray:
+    wx = _overlap_matrix(layer.extent.x0, layer.extent.x1, layer.radiance.shape[1], extent.x0, extent.x1, cols)
+    wy = _overlap_matrix(layer.extent.y0, layer.extent.y1, layer.radiance.shape[0], extent.y0, extent.y1, rows)
+    return _apply(wy, wx, layer.radiance)
+
+
+def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, cube: np.ndarray) -> np.ndarray:
+    rows_in, cols_in, bands = cube.shape
+    tmp = wy @ cube.reshape(rows_in, cols_in * bands)  # (rows, cols_in*bands)
+    tmp = tmp.reshape(-1, cols_in, bands).transpose(1, 0, 2).reshape(cols_in, -1)
+    out = (wx @ tmp).reshape(wx.shape[0], -1, bands).transpose(1, 0, 2)
+    return np.ascontiguousarray(out, dtype=np.float32)
+
+
+def _overlap_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: float, n_dst: int) -> sp.csr_matrix:
+    """Sparse (n_dst, n_src) matrix: fraction of each destination cell covered by each
+    source cell (rows sum to the covered fraction of the destination cell)."""
+    src_edges = np.linspace(src0, src1, n_src + 1)
+    dst_edges = np.linspace(dst0, dst1, n_dst + 1)
+    dst_width = (dst1 - dst0) / n_dst
+    rows, cols, vals = [], [], []
+    # For each destination cell, the source cells it overlaps (searchsorted on edges).
+    first = np.clip(np.searchsorted(src_edges, dst_edges[:-1], side="right") - 1, 0, n_src - 1)
+    last = np.clip(np.searchsorted(src_edges, dst_edges[1:], side="left") - 1, 0, n_src - 1)
+    span = int((last - first).max(initial=0)) + 1
+    for k in range(span):
+        j = first + k
+        valid = j <= last
+        lo = np.maximum(dst_edges[:-1], src_edges[np.minimum(j, n_src - 1)])
+        hi = np.minimum(dst_edges[1:], src_edges[np.minimum(j + 1, n_src)])
+        frac = np.clip(hi - lo, 0.0, None) / dst_width
+        keep = valid & (frac > 0)
+        rows.append(np.nonzero(keep)[0])
+        cols.append(j[keep])
+        vals.append(frac[keep])
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n_dst, n_src)
+    )
