@@ -1,0 +1,176 @@
+"""``metricscenes`` command line: generate, verify, info, preview."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from rich.table import Table
+
+from metricscenes import __version__
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="Seeded metric driving scenes rendered as spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).")
+console = Console()
+err = Console(stderr=True)
+
+
+def fail(message: str, code: int = 2) -> None:
+    """One-line error, non-zero exit, no traceback."""
+    err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    raise typer.Exit(code)
+
+
+def _user_errors():
+    from metricscenes.manifest import ManifestError
+    from metricscenes.render import RenderError
+    from metricscenes.store import CollectionError
+
+    return (ManifestError, CollectionError, RenderError)
+
+
+@app.command()
+def generate(
+    manifest: Annotated[Path, typer.Option("--manifest", "-m", help="collection manifest (YAML)")],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="collection folder to write")] = None,
+    workers: Annotated[int, typer.Option(min=1, help="render processes")] = 1,
+    threads: Annotated[Optional[int], typer.Option(min=1, help="render threads per process")] = None,
+    dry_run: Annotated[bool, typer.Option("--dry-run", help="print the plan, render nothing")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
+) -> None:
+    """Render a collection (resumes an interrupted run; same manifest → same bytes)."""
+    from metricscenes.manifest import load_manifest
+    from metricscenes.plan import plan_collection
+
+    try:
+        m = load_manifest(manifest)
+        if dry_run:
+            scenes = [s.summary() for s in plan_collection(m)]
+            if as_json:
+                print(json.dumps({"manifest": m.name, "manifest_sha256": m.sha256(), "scenes": scenes}, indent=1))
+            else:
+                _plan_table(scenes)
+            return
+        if out is None:
+            fail("--out is required unless --dry-run")
+        from metricscenes.generate import generate as run_generate
+
+        started = time.perf_counter()
+        with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                      TimeElapsedColumn(), TimeRemainingColumn(), console=err, transient=False,
+                      disable=as_json) as bar:
+            task = bar.add_task(f"rendering {m.name}", total=None)
+
+            def progress(done: int, total: int, key: str | None) -> None:
+                bar.update(task, completed=done, total=total, description=f"rendering {key or m.name}")
+
+            run_generate(m, out, workers=workers, threads=threads, progress=progress)
+        seconds = time.perf_counter() - started
+        if as_json:
+            print(json.dumps({"collection": str(out), "seconds": round(seconds, 2)}))
+        else:
+            console.print(f"wrote {out} in {seconds:.1f} s")
+    except _user_errors() as exc:
+        fail(str(exc))
+
+
+def _plan_table(scenes: list[dict]) -> None:
+    table = Table(title="plan")
+    for col in ("scene_id", "distance_m", "car_id", "road_id", "heading", "sky_day_id", "sky_night_id"):
+        table.add_column(col)
+    for s in scenes:
+        table.add_row(*(str(s[c]) for c in ("scene_id", "distance_m", "car_id", "road_id", "heading",
+                                             "sky_day_id", "sky_night_id")))
+    console.print(table)
+
+
+@app.command()
+def info(
+    collection: Annotated[Path, typer.Argument(help="collection folder")],
+    as_json: Annotated[bool, typer.Option("--json")] = False,
+) -> None:
+    """Summarise a collection."""
+    from metricscenes.store import Collection
+
+    try:
+        c = Collection.open(collection)
+    except _user_errors() as exc:
+        fail(str(exc))
+    scenes = c.scenes()
+    size = sum(p.stat().st_size for p in (collection / "radiance.zarr").rglob("*") if p.is_file())
+    summary = {
+        "name": c.name, "protocol": c.protocol, "manifest_sha256": c.manifest_sha256,
+        "package_version": c.resolved["package_version"], "scenes": len(scenes),
+        "environments": len({s.environment_id for s in scenes}),
+        "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.conditions,
+        "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved["arrays"]),
+        "radiance_units": "W sr-1 m-2 nm-1", "wavelengths_nm": [400, 700, 10], "store_bytes": size,
+    }
+    if as_json:
+        print(json.dumps(summary, indent=1))
+        return
+    table = Table(title=f"collection {c.name}", show_header=False)
+    for k, v in summary.items():
+        table.add_row(k, str(v))
+    console.print(table)
+
+
+@app.command()
+def verify(collection: Annotated[Path, typer.Argument(help="collection folder")]) -> None:
+    """Recompute every array's sha256 against manifest.resolved.yaml."""
+    from metricscenes.store import Collection
+
+    try:
+        bad = Collection.open(collection).verify()
+    except _user_errors() as exc:
+        fail(str(exc))
+    if bad:
+        fail(f"{len(bad)} array(s) do not match their sha256, first: {bad[0]}", code=1)
+    console.print("all arrays match their sha256")
+
+
+@app.command()
+def preview(
+    collection: Annotated[Path, typer.Argument(help="collection folder")],
+    condition: Annotated[str, typer.Option(help="condition to show")] = "day",
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="PNG to write")] = None,
+    columns: Annotated[int, typer.Option(min=1)] = 6,
+) -> None:
+    """Write an sRGB contact sheet of every scene (display rendering, not a camera)."""
+    from metricscenes.preview import contact_sheet, radiance_to_srgb8
+    from metricscenes.store import Collection
+
+    try:
+        c = Collection.open(collection)
+        tiles, labels = [], []
+        width, height = c.reference_grid
+        for s in c.scenes():
+            # Sample the composite at 2x the reference grid so distant cars stay visible.
+            cube = c.radiance(s.scene_id, condition).resample(width * 2, height * 2)
+            tiles.append(radiance_to_srgb8(cube))
+            labels.append(f"{s.scene_id} {condition}")
+    except _user_errors() as exc:
+        fail(str(exc))
+    path = contact_sheet(tiles, labels, columns, out or collection / f"preview-{condition}.png")
+    console.print(f"wrote {path}")
+
+
+@app.callback(invoke_without_command=True)
+def _version(version: Annotated[bool, typer.Option("--version", help="print the version")] = False) -> None:
+    if version:
+        print(__version__)
+        raise typer.Exit()
+
+
+def main() -> None:
+    app(prog_name="metricscenes")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

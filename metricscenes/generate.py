@@ -1,0 +1,217 @@
+"""Render a collection: plan, render every unit of work, write the store.
+
+Units of work are the plates (one per environment: its background without the car,
+once per light group) and the insets (one per scene: a window around the car at
+finer angular sampling, once per light group). Each unit writes its own zarr arrays
+and then a small record under ``progress/``; a rerun skips units whose record exists,
+so a killed run resumes, and because every unit is a pure function of the manifest
+the result is bit-identical to an uninterrupted run, whatever the number of workers.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+from multiprocessing import get_context
+from pathlib import Path
+
+import yaml
+
+from metricscenes import __version__
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+from metricscenes.groundtruth import box_tan_to_xywh, car_box_tan, coco_groundtruth
+from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
+from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
+from metricscenes.store import (
+    GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, write_atomic,
+    write_radiance,
+)
+
+# Margins of the inset window around the car's projected box, as fractions of the box:
+# the sides and top catch reflections and antialiasing; the bottom catches the shadow
+# and the lamps' footprint on the road.
+INSET_MARGIN = {"left": 0.3, "right": 0.3, "top": 0.2, "bottom": 0.6}
+
+
+@dataclass(frozen=True)
+class Unit:
+    kind: str  # 'plate' | 'inset'
+    key: str
+    environment: EnvironmentPlan
+    distance_m: float | None
+    seed: int
+
+
+def plan_units(scenes: list[ScenePlan]) -> list[Unit]:
+    units: dict[str, Unit] = {}
+    for s in scenes:
+        env = s.environment
+        units.setdefault(env.key, Unit("plate", env.key, env, None, env.seed))
+        units[s.scene_id] = Unit("inset", s.scene_id, env, s.distance_m, s.seed)
+    return list(units.values())
+
+
+def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
+    """Choose the inset film: scale ``k`` of the reference grid and the crop (x, y, w, h)
+    in that film's pixels. ``k`` gives ``inset_pixel_mrad`` sampling unless the window
+    would exceed ``inset_max_px`` (near cars, which are large in every camera anyway)."""
+    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    e = REFERENCE_EXTENT
+    bw, bh = box_tan[2] - box_tan[0], box_tan[3] - box_tan[1]
+    x0 = max(e.x0, box_tan[0] - INSET_MARGIN["left"] * bw)
+    x1 = min(e.x1, box_tan[2] + INSET_MARGIN["right"] * bw)
+    y0 = max(e.y0, box_tan[1] - INSET_MARGIN["top"] * bh)
+    y1 = min(e.y1, box_tan[3] + INSET_MARGIN["bottom"] * bh)
+    ref_pitch_mrad = 1e3 * e.width / ref_w
+    window_ref_px = max((x1 - x0) / e.width * ref_w, (y1 - y0) / e.height * ref_h)
+    k_fine = math.ceil(ref_pitch_mrad / manifest.render.inset_pixel_mrad)
+    k_cap = math.floor(manifest.render.inset_max_px / max(window_ref_px, 1e-9))
+    k = max(1, min(k_fine, k_cap))
+    big_w, big_h = ref_w * k, ref_h * k
+    cx0 = max(0, math.floor((x0 - e.x0) / e.width * big_w))
+    cx1 = min(big_w, math.ceil((x1 - e.x0) / e.width * big_w))
+    cy0 = max(0, math.floor((y0 - e.y0) / e.height * big_h))
+    cy1 = min(big_h, math.ceil((y1 - e.y0) / e.height * big_h))
+    return k, cx0, cy0, cx1 - cx0, cy1 - cy0
+
+
+def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None) -> dict:
+    """Render and write one unit (runs in a worker process); return its progress record."""
+    from metricscenes import scene as scene_mod
+    from metricscenes.render import Film, render_radiance, use_variant
+
+    manifest = Manifest.model_validate(manifest_json)
+    use_variant(manifest.render.variant, threads)
+    root = Path(out_dir)
+    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    env = unit.environment
+    parts = scene_mod.environment_parts(env)
+    record: dict = {"unit": unit.key, "kind": unit.kind, "arrays": {}}
+    started = time.perf_counter()
+    if unit.kind == "plate":
+        film, spp, kind, groups = Film(ref_w, ref_h), manifest.render.plate_spp, "plates", [
+            g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
+        extent = REFERENCE_EXTENT
+    else:
+        pose = scene_mod.car_pose(env, unit.distance_m)
+        parts = parts.merged(scene_mod.car_parts(env, pose))
+        box = car_box_tan(scene_mod.car_vertices(env, pose))
+        k, cx, cy, cw, ch = inset_window(box, manifest)
+        film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch)
+        spp, kind, groups = manifest.render.inset_spp, "insets", list(manifest.light_groups)
+        e = REFERENCE_EXTENT
+        extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
+                           e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
+        record.update(box_tan=list(box), inset_scale=k, pose=asdict(pose),
+                      bbox_xywh=box_tan_to_xywh(box, ref_w, ref_h))
+    for i, group in enumerate(groups):
+        if not scene_mod.has_emitters(parts, group):
+            continue
+        sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
+                                  max_depth=manifest.render.max_depth)
+        cube = render_radiance(sd, spp)
+        sha = write_radiance(root, kind, unit.key, group, cube, extent, {"spp": spp, "seed": unit.seed})
+        record["arrays"][f"{kind}/{unit.key}/{group}"] = sha
+    record["seconds"] = round(time.perf_counter() - started, 3)
+    return record
+
+
+def _progress_path(root: Path, key: str) -> Path:
+    return root / PROGRESS_DIR / f"{key}.json"
+
+
+def _load_record(root: Path, key: str) -> dict | None:
+    try:
+        record = json.loads(_progress_path(root, key).read_text())
+    except (OSError, json.JSONDecodeError):
+        return None  # absent or torn: redo the unit
+    return record if record.get("unit") == key else None
+
+
+def _prepare(root: Path, manifest: Manifest) -> None:
+    import zarr
+
+    root.mkdir(parents=True, exist_ok=True)
+    (root / PROGRESS_DIR).mkdir(exist_ok=True)
+    stamp = root / PROGRESS_DIR / "manifest_sha256"
+    if stamp.exists() and stamp.read_text().strip() != manifest.sha256():
+        raise CollectionError(
+            f"{root}: holds a collection of another manifest; choose another --out or delete it"
+        )
+    write_atomic(stamp, manifest.sha256() + "\n")
+    zroot = zarr.open_group(str(root / RADIANCE_STORE), mode="a")
+    zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
+                        "dimension_names": ["y", "x", "wavelength"]})
+    for name in ("plates", "insets"):
+        zroot.require_group(name)
+
+
+def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threads: int | None = None,
+             progress=None) -> Path:
+    """Render ``manifest`` into ``out_dir`` (resuming what is already done).
+
+    ``workers`` processes render units in parallel; each uses ``threads`` render
+    threads (default: the CPU count divided by the workers). ``progress`` is an
+    optional callable ``(done, total, unit_key)``.
+    """
+    root = Path(out_dir)
+    _prepare(root, manifest)
+    scenes = plan_collection(manifest)
+    units = plan_units(scenes)
+    records = {u.key: _load_record(root, u.key) for u in units}
+    todo = [u for u in units if records[u.key] is None]
+    threads = threads or max(1, (os.cpu_count() or 1) // max(1, workers))
+    manifest_json = manifest.model_dump(mode="json")
+    done = len(units) - len(todo)
+    if progress:
+        progress(done, len(units), None)
+
+    def finish(record: dict) -> None:
+        nonlocal done
+        write_atomic(_progress_path(root, record["unit"]), json.dumps(record, indent=1, sort_keys=True))
+        records[record["unit"]] = record
+        done += 1
+        if progress:
+            progress(done, len(units), record["unit"])
+
+    if workers <= 1:
+        for u in todo:
+            finish(render_unit(manifest_json, u, str(root), threads))
+    else:
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            futures = [pool.submit(render_unit, manifest_json, u, str(root), threads) for u in todo]
+            for f in futures:
+                finish(f.result())
+    _finalize(root, manifest, scenes, records)
+    return root
+
+
+def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, dict]) -> None:
+    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    images, boxes = [], []
+    for s in scenes:
+        rec = records[s.scene_id]
+        env = s.environment
+        images.append({
+            "id": s.image_id, "file_name": f"{s.scene_id}.png", "width": ref_w, "height": ref_h,
+            "scene_id": s.scene_id, "environment_id": env.environment_id, "distance_m": s.distance_m,
+            "car_id": env.car_id, "road_id": env.road_id, "heading": env.heading,
+        })
+        boxes.append(rec["bbox_xywh"])
+    info = {"description": f"metricscenes collection {manifest.name}", "version": __version__,
+            "protocol": manifest.protocol, "manifest_sha256": manifest.sha256()}
+    gt = coco_groundtruth(images, boxes, info)
+    arrays = {path: sha for key in sorted(records) for path, sha in sorted(records[key]["arrays"].items())}
+    resolved = {
+        "package_version": __version__,
+        "manifest_sha256": manifest.sha256(),
+        "manifest": manifest.model_dump(mode="json"),
+        "arrays": arrays,
+        "plan": [s.summary() for s in scenes],
+    }
+    write_atomic(root / GROUNDTRUTH_FILE, json.dumps(gt, indent=1))
+    write_atomic(root / RESOLVED_MANIFEST_FILE, yaml.safe_dump(resolved, sort_keys=False))

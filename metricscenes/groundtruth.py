@@ -1,0 +1,63 @@
+"""COCO ground truth: one ``car`` box per scene in the reference pixel grid.
+
+The box is the tight box of the car's projected mesh vertices, clipped to the image
+(the car is never occluded: trees and poles stand off the road). Boxes are floats in
+reference-grid pixels; a camera scales them to its own grid by its size ratio, as
+every camera covers the same field of view.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from metricscenes.geometry import tan_to_pixels, world_to_tan
+
+CAR_CATEGORY = {"id": 3, "name": "car", "supercategory": "vehicle"}
+
+
+def car_box_tan(vertices_world_m: np.ndarray) -> tuple[float, float, float, float]:
+    """Tight box (x0, y0, x1, y1) of the projected vertices in tangent coordinates."""
+    t = world_to_tan(vertices_world_m)
+    return (float(t[:, 0].min()), float(t[:, 1].min()), float(t[:, 0].max()), float(t[:, 1].max()))
+
+
+def box_tan_to_xywh(box_tan, width_px: int, height_px: int) -> list[float]:
+    """Convert a tangent-coordinate box to a COCO ``[x, y, w, h]`` box in a pixel grid
+    covering the reference field of view, clipped to the grid."""
+    corners = tan_to_pixels(np.array([[box_tan[0], box_tan[1]], [box_tan[2], box_tan[3]]]), width_px, height_px)
+    x0, y0 = np.clip(corners[0], 0, [width_px, height_px])
+    x1, y1 = np.clip(corners[1], 0, [width_px, height_px])
+    return [round(float(x0), 4), round(float(y0), 4), round(float(x1 - x0), 4), round(float(y1 - y0), 4)]
+
+
+def coco_groundtruth(images: list[dict], boxes_xywh: list[list[float]], info: dict) -> dict:
+    """Assemble the COCO dict. ``images`` carry id, file_name, width, height and the
+    scene facts (scene_id, environment_id, distance_m, ...)."""
+    annotations = [
+        {
+            "id": i + 1,
+            "image_id": image["id"],
+            "category_id": CAR_CATEGORY["id"],
+            "bbox": box,
+            "area": round(box[2] * box[3], 4),
+            "iscrowd": 0,
+        }
+        for i, (image, box) in enumerate(zip(images, boxes_xywh, strict=True))
+    ]
+    return {"info": info, "images": images, "annotations": annotations, "categories": [CAR_CATEGORY]}
+
+
+def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int) -> dict:
+    """The same ground truth on another grid covering the same field of view (a camera's)."""
+    out = {**groundtruth, "images": [], "annotations": []}
+    scale = {}
+    for image in groundtruth["images"]:
+        sx, sy = width_px / image["width"], height_px / image["height"]
+        scale[image["id"]] = (sx, sy)
+        out["images"].append({**image, "width": width_px, "height": height_px})
+    for ann in groundtruth["annotations"]:
+        sx, sy = scale[ann["image_id"]]
+        x, y, w, h = ann["bbox"]
+        box = [x * sx, y * sy, w * sx, h * sy]
+        out["annotations"].append({**ann, "bbox": box, "area": box[2] * box[3]})
+    return out

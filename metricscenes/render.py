@@ -1,0 +1,115 @@
+"""Mitsuba rendering of 31-band spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).
+
+Uses a ``specfilm`` with one 10 nm box band per ISET wavelength, so each channel is
+the band-averaged radiance in the emitters' units, a ``box`` reconstruction filter
+(bit-identical results whatever the thread count) and a ``stratified`` sampler (less
+per-band noise). On CPU the ``scalar_spectral`` variant is as fast as LLVM for this
+film and needs no libLLVM (see docs/performance.md); the LLVM variants crash with the
+system's libllvm15 and are only used when asked for explicitly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from metricscenes.geometry import CAMERA_HEIGHT_M, HORIZONTAL_FOV_DEG
+from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
+
+_active_variant: str | None = None
+
+
+class RenderError(RuntimeError):
+    """Mitsuba could not be set up or a render failed (one-line message)."""
+
+
+def use_variant(variant: str = "scalar_spectral", threads: int | None = None):
+    """Select the Mitsuba variant once per process and return the ``mitsuba`` module."""
+    global _active_variant
+    import drjit as dr
+    import mitsuba as mi
+
+    if _active_variant != variant:
+        if variant not in mi.variants():
+            raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
+        mi.set_variant(variant)
+        _active_variant = variant
+    if threads is not None:
+        dr.set_thread_count(max(1, int(threads)))
+    return mi
+
+
+@dataclass(frozen=True)
+class Film:
+    """A perspective film covering the reference field of view at ``width x height``
+    pixels, of which only the crop window is rendered (crop = whole film by default)."""
+
+    width: int
+    height: int
+    crop_x: int = 0
+    crop_y: int = 0
+    crop_width: int | None = None
+    crop_height: int | None = None
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return (self.crop_width or self.width, self.crop_height or self.height)
+
+
+def spectral_film_dict(film: Film) -> dict:
+    cols, rows = film.size
+    d = {
+        "type": "specfilm",
+        "width": film.width,
+        "height": film.height,
+        "crop_offset_x": film.crop_x,
+        "crop_offset_y": film.crop_y,
+        "crop_width": cols,
+        "crop_height": rows,
+        "rfilter": {"type": "box"},
+    }
+    half = BAND_WIDTH_NM / 2
+    for w in WAVELENGTHS_NM:
+        # Zero-padded names: specfilm orders channels alphabetically by name.
+        d[f"b{int(w):04d}"] = {
+            "type": "irregular",
+            "wavelengths": f"{w - half}, {w + half}",
+            "values": f"{1 / BAND_WIDTH_NM}, {1 / BAND_WIDTH_NM}",
+        }
+    return d
+
+
+def sensor_dict(film: Film, spp: int, seed: int) -> dict:
+    import mitsuba as mi
+
+    return {
+        "type": "perspective",
+        "fov": HORIZONTAL_FOV_DEG,
+        "fov_axis": "x",
+        "near_clip": 0.05,
+        "far_clip": 1.0e5,
+        "to_world": mi.ScalarTransform4f().look_at(
+            origin=[0.0, 0.0, CAMERA_HEIGHT_M], target=[1.0, 0.0, CAMERA_HEIGHT_M], up=[0.0, 0.0, 1.0]
+        ),
+        "sampler": {"type": "stratified", "sample_count": int(spp), "seed": int(seed) % 2**31},
+        "film": spectral_film_dict(film),
+    }
+
+
+def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
+    """Render a scene dict (with its sensor) to a (rows, cols, 31) float32 radiance cube."""
+    import mitsuba as mi
+
+    try:
+        scene = mi.load_dict(scene_dict)
+        image = np.array(mi.render(scene, spp=int(spp)), dtype=np.float32)
+    except Exception as exc:  # Mitsuba raises plain RuntimeErrors with long messages
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise RenderError(f"render failed: {first}") from exc
+    if image.ndim != 3 or image.shape[2] != WAVELENGTHS_NM.size:
+        raise RenderError(f"unexpected film output shape {image.shape}")
+    # Negative values cannot occur in radiance; NaN would poison every later stage.
+    if not np.all(np.isfinite(image)):
+        raise RenderError("render produced non-finite radiance")
+    return image

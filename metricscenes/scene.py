@@ -1,0 +1,99 @@
+"""Assemble a Mitsuba scene for one environment, one light group and one film.
+
+The plate of an environment is its scene without the car; an inset adds the car.
+A light group switches on only its own emitters: the sky of that kind, the car's
+lamps, or the street lights (radiance is linear in emitter power, so a condition is
+a weighted sum of the groups' renders).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from metricscenes.assets import cars, roads, skies
+from metricscenes.assets.parts import SceneParts
+from metricscenes.plan import EnvironmentPlan
+from metricscenes.render import Film, sensor_dict
+
+SKY_GROUPS = {"sky_day": "sky_day_id", "sky_dusk": "sky_dusk_id", "sky_night": "sky_night_id"}
+
+
+@dataclass(frozen=True)
+class CarPose:
+    """Where the car stands: ground point under its centre (world m) and yaw (rad, 0 = facing +x)."""
+
+    x_m: float
+    y_m: float
+    yaw_rad: float
+
+
+def car_pose(env: EnvironmentPlan, distance_m: float) -> CarPose:
+    """Place the environment's car ``distance_m`` ahead of the camera (to the car's centre).
+
+    'away': in the camera's lane, driving away (we see its rear); 'oncoming': in the
+    nearest oncoming lane, facing the camera (we see its front and head lamps).
+    """
+    road = roads.road_spec(env.road_id)
+    lane_y = roads.lane_center_y_m(road, 0, "same" if env.heading == "away" else "oncoming")
+    base_yaw = 0.0 if env.heading == "away" else math.pi
+    return CarPose(
+        x_m=float(distance_m),
+        y_m=float(lane_y + env.lateral_offset_m),
+        yaw_rad=base_yaw + math.radians(env.yaw_deg),
+    )
+
+
+def environment_parts(env: EnvironmentPlan) -> SceneParts:
+    return roads.road_parts(roads.road_spec(env.road_id), seed=env.seed)
+
+
+def car_parts(env: EnvironmentPlan, pose: CarPose) -> SceneParts:
+    return cars.car_parts(cars.car_spec(env.car_id), (pose.x_m, pose.y_m), pose.yaw_rad)
+
+
+def car_vertices(env: EnvironmentPlan, pose: CarPose) -> np.ndarray:
+    """All car mesh vertices in world metres (N, 3), for ground truth and inset windows."""
+    return cars.car_vertices_world(cars.car_spec(env.car_id), (pose.x_m, pose.y_m), pose.yaw_rad)
+
+
+def has_emitters(parts: SceneParts, light_group: str) -> bool:
+    """Whether rendering ``light_group`` would put any light in these parts."""
+    if light_group in SKY_GROUPS:
+        return True
+    return any(lamp.light_group == light_group for lamp in parts.lamps)
+
+
+def scene_dict(
+    env: EnvironmentPlan,
+    parts: SceneParts,
+    light_group: str,
+    film: Film,
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int,
+) -> dict:
+    """A ``mi.load_dict``-ready scene lit by ``light_group`` alone."""
+    scene: dict = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": int(max_depth)},
+        "sensor": sensor_dict(film, spp, seed),
+    }
+    scene.update(parts.shapes)
+    for lamp in parts.lamps:
+        on = lamp.light_group == light_group
+        if lamp.shape is not None:
+            shape = dict(lamp.shape)
+            if on:
+                shape["emitter"] = lamp.emitter
+            scene[f"lamp_{lamp.name}"] = shape
+        elif on:
+            scene[f"lamp_{lamp.name}"] = lamp.emitter
+    if light_group in SKY_GROUPS:
+        sky = skies.sky_spec(getattr(env, SKY_GROUPS[light_group]))
+        for key, emitter in skies.sky_emitters(sky).items():
+            scene[f"sky_{key}"] = emitter
+    return scene

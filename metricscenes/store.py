@@ -1,0 +1,236 @@
+"""The collection store: the only way to read (and write) a rendered collection.
+
+Layout of a collection folder::
+
+    radiance.zarr/                      zarr v3
+      plates/<env>/<light_group>        (y, x, wavelength) float32, whole field of view
+      insets/<scene>/<light_group>      (y, x, wavelength) float32, a window around the car
+    groundtruth.json                    COCO, one car box per scene (reference grid)
+    manifest.resolved.yaml              manifest as run, package version, sha256 of every array
+    progress/<unit>.json                one record per finished unit of work (resume)
+
+Every array is one chunk written by one unit of work, so workers never share a file.
+Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)
+and ``light_group``. A light group that puts no light in a unit (e.g. street lights
+on a road without any) has no array: it reads as zero.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from metricscenes.geometry import TanExtent
+from metricscenes.radiance import RadianceLayer, SpectralScene
+from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
+
+RADIANCE_STORE = "radiance.zarr"
+GROUNDTRUTH_FILE = "groundtruth.json"
+RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
+PROGRESS_DIR = "progress"
+DIMENSIONS = ("y", "x", "wavelength")
+
+
+class CollectionError(ValueError):
+    """A collection folder is missing, incomplete or corrupted (one-line message)."""
+
+
+def array_sha256(array: np.ndarray) -> str:
+    """sha256 over dtype, shape and the C-order little-endian bytes of an array."""
+    a = np.ascontiguousarray(array, dtype=np.dtype(array.dtype).newbyteorder("<"))
+    h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
+    h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write a text file through a temporary file and a rename, so readers never see half of it."""
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,
+                   extent: TanExtent, extra_attrs: dict | None = None) -> str:
+    """Write one radiance cube as a single-chunk zarr array; return its sha256."""
+    import zarr
+
+    cube = np.ascontiguousarray(cube, dtype=np.float32)
+    attrs = {
+        "units": RADIANCE_UNITS,
+        "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
+        "extent_tan": list(extent.as_tuple()),
+        "light_group": light_group,
+        **(extra_attrs or {}),
+    }
+    arr = zarr.create_array(
+        store=str(root / RADIANCE_STORE), name=f"{kind}/{unit}/{light_group}", shape=cube.shape,
+        dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
+        overwrite=True,
+    )
+    arr[...] = cube
+    return array_sha256(cube)
+
+
+@dataclass(frozen=True)
+class SceneRecord:
+    """What the store knows of one scene without reading its radiance."""
+
+    scene_id: str
+    image_id: int
+    environment_id: int
+    distance_m: float
+
+
+class Collection:
+    """A rendered collection, opened read-only. Use :meth:`open`."""
+
+    def __init__(self, root: Path, resolved: dict, groundtruth: dict):
+        self.root = root
+        self.resolved = resolved
+        self._groundtruth = groundtruth
+        self._images = {img["scene_id"]: img for img in groundtruth["images"]}
+        self._zarr = None
+
+    @classmethod
+    def open(cls, path: str | Path) -> "Collection":
+        root = Path(path)
+        if not root.is_dir():
+            raise CollectionError(f"{root}: no such collection folder")
+        for name in (RESOLVED_MANIFEST_FILE, GROUNDTRUTH_FILE, RADIANCE_STORE):
+            if not (root / name).exists():
+                raise CollectionError(
+                    f"{root}: not a complete collection ({name} is missing; rerun `metricscenes generate` to finish it)"
+                )
+        try:
+            resolved = yaml.safe_load((root / RESOLVED_MANIFEST_FILE).read_text())
+            groundtruth = json.loads((root / GROUNDTRUTH_FILE).read_text())
+        except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise CollectionError(f"{root}: corrupted metadata ({type(exc).__name__})") from None
+        if not isinstance(resolved, dict) or "manifest" not in resolved or "arrays" not in resolved:
+            raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} lacks 'manifest' or 'arrays'")
+        return cls(root, resolved, groundtruth)
+
+    # --- facts -------------------------------------------------------------------------
+    @property
+    def manifest(self) -> dict:
+        return self.resolved["manifest"]
+
+    @property
+    def name(self) -> str:
+        return self.manifest["name"]
+
+    @property
+    def protocol(self) -> str:
+        return self.manifest["protocol"]
+
+    @property
+    def manifest_sha256(self) -> str:
+        return self.resolved["manifest_sha256"]
+
+    @property
+    def conditions(self) -> dict[str, dict[str, float]]:
+        return self.manifest["conditions"]
+
+    @property
+    def reference_grid(self) -> tuple[int, int]:
+        """(width_px, height_px) of the plates and ground-truth boxes."""
+        g = self.manifest["reference_grid"]
+        return (g["width_px"], g["height_px"])
+
+    def scenes(self) -> list[SceneRecord]:
+        return [
+            SceneRecord(img["scene_id"], img["id"], img["environment_id"], float(img["distance_m"]))
+            for img in self._groundtruth["images"]
+        ]
+
+    def groundtruth(self) -> dict:
+        """The COCO ground truth (a deep copy: callers may modify it)."""
+        return json.loads(json.dumps(self._groundtruth))
+
+    # --- radiance ----------------------------------------------------------------------
+    def _group(self):
+        import zarr
+
+        if self._zarr is None:
+            self._zarr = zarr.open_group(str(self.root / RADIANCE_STORE), mode="r")
+        return self._zarr
+
+    def _weights(self, condition: str | dict[str, float]) -> dict[str, float]:
+        if isinstance(condition, str):
+            if condition not in self.conditions:
+                raise CollectionError(
+                    f"unknown condition {condition!r} (this collection has: {', '.join(self.conditions)})"
+                )
+            return dict(self.conditions[condition])
+        return dict(condition)
+
+    def _mix(self, kind: str, unit: str, weights: dict[str, float]) -> RadianceLayer | None:
+        group = self._group()
+        path = f"{kind}/{unit}"
+        if path not in group:
+            raise CollectionError(f"{self.root}: {path} is missing from {RADIANCE_STORE}")
+        node = group[path]
+        total, extent = None, None
+        for light_group in node.array_keys():
+            arr = node[light_group]
+            extent = TanExtent(*arr.attrs["extent_tan"])
+            w = weights.get(light_group, 0.0)
+            if w == 0.0:
+                continue
+            cube = np.asarray(arr[...], dtype=np.float32) * np.float32(w)
+            total = cube if total is None else total + cube
+        if extent is None:
+            return None
+        if total is None:
+            arr = node[next(iter(node.array_keys()))]
+            total = np.zeros(arr.shape, dtype=np.float32)
+        return RadianceLayer(total, extent)
+
+    def radiance(self, scene_id: str, condition: str | dict[str, float]) -> SpectralScene:
+        """The scene's spectral radiance under a condition (a name from the manifest, or
+        light-group weights): the plate and the car's inset, each the weighted sum of its
+        light groups' renders."""
+        if scene_id not in self._images:
+            raise CollectionError(f"unknown scene {scene_id!r}")
+        img = self._images[scene_id]
+        weights = self._weights(condition)
+        plate = self._mix("plates", f"env{img['environment_id']:03d}", weights)
+        inset = self._mix("insets", scene_id, weights)
+        layers = tuple(layer for layer in (plate, inset) if layer is not None)
+        if plate is None:
+            raise CollectionError(f"{self.root}: scene {scene_id} has no plate")
+        return SpectralScene(
+            layers=layers,
+            metadata={"scene_id": scene_id, "condition": condition, "distance_m": img["distance_m"],
+                      "environment_id": img["environment_id"]},
+        )
+
+    def angular_sampling(self, scene_id: str) -> list[dict]:
+        """Per layer (plate, inset): its extent in tangent coordinates and its sampling in mrad per pixel."""
+        scene = self.radiance(scene_id, {})
+        return [
+            {"layer": name, "extent_tan": layer.extent.as_tuple(),
+             "mrad_per_px": (1e3 * layer.pixel_tan[0], 1e3 * layer.pixel_tan[1]),
+             "shape": layer.radiance.shape}
+            for name, layer in zip(("plate", "inset"), scene.layers)
+        ]
+
+    def verify(self) -> list[str]:
+        """Recompute every array's sha256; return the paths whose content does not match."""
+        bad = []
+        group = self._group()
+        for path, expected in sorted(self.resolved["arrays"].items()):
+            try:
+                actual = array_sha256(np.asarray(group[path][...]))
+            except Exception:  # missing or unreadable chunk
+                actual = None
+            if actual != expected:
+                bad.append(path)
+        return bad

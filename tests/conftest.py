@@ -1,0 +1,38 @@
+"""Shared fixtures: the smoke collection is rendered once per test session."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SMOKE_MANIFEST = REPO / "manifests" / "smoke.yaml"
+
+
+def model_dir() -> Path:
+    return Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
+
+
+def require_model(name: str) -> Path:
+    path = model_dir() / name
+    if not path.is_file():
+        pytest.skip(f"{name} not found in METRICSCENES_MODEL_DIR={model_dir()} (set it to the shared models folder)")
+    return path
+
+
+@pytest.fixture(scope="session")
+def smoke_manifest():
+    from metricscenes.manifest import load_manifest
+
+    return load_manifest(SMOKE_MANIFEST)
+
+
+@pytest.fixture(scope="session")
+def smoke_collection(tmp_path_factory, smoke_manifest) -> Path:
+    from metricscenes.generate import generate
+
+    out = tmp_path_factory.mktemp("smoke") / "collection"
+    generate(smoke_manifest, out)
+    return out
