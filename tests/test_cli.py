@@ -1,0 +1,53 @@
+"""The command lines: user errors end in one line and a non-zero exit, never a traceback."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from conftest import REPO, SMOKE_MANIFEST
+
+
+def _run(module, *args):
+    return subprocess.run([sys.executable, "-m", module, *map(str, args)], capture_output=True, text=True,
+                          cwd=REPO, timeout=300)
+
+
+def _one_line_error(proc):
+    assert proc.returncode != 0
+    assert "Traceback" not in proc.stderr + proc.stdout
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, proc.stderr
+    return lines[0]
+
+
+def test_malformed_manifest_is_one_line(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(SMOKE_MANIFEST.read_text().replace("environments: 2", "environments: -3"))
+    line = _one_line_error(_run("metricscenes.cli", "generate", "--manifest", bad, "--out", tmp_path / "c"))
+    assert "environments" in line
+    assert not (tmp_path / "c").exists()
+
+
+def test_dry_run_prints_the_plan():
+    proc = _run("metricscenes.cli", "generate", "--manifest", SMOKE_MANIFEST, "--dry-run", "--json")
+    assert proc.returncode == 0, proc.stderr
+    plan = json.loads(proc.stdout)
+    assert len(plan["scenes"]) == 12
+    assert {"scene_id", "environment_id", "distance_m", "car_id", "road_id", "sky_day_id"} <= set(plan["scenes"][0])
+
+
+@pytest.mark.slow
+def test_missing_model_file_is_one_line(smoke_collection, tmp_path):
+    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", smoke_collection,
+                                "--model", tmp_path / "nope.onnx", "--out", tmp_path / "r"))
+    assert "nope.onnx" in line
+
+
+def test_unknown_camera_and_collection_are_one_line(tmp_path):
+    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam99", "--collection", tmp_path,
+                                "--out", tmp_path / "r"))
+    assert "cam99" in line
+    line = _one_line_error(_run("metricscenes.cli", "info", tmp_path / "absent"))
+    assert "absent" in line

@@ -1,0 +1,127 @@
+"""Generation: structure of the store, determinism, seeds, resume, corruption."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+import yaml
+
+from metricscenes.generate import generate
+from metricscenes.store import Collection, CollectionError
+
+pytestmark = pytest.mark.slow
+
+
+def _resolved(path):
+    return yaml.safe_load((path / "manifest.resolved.yaml").read_text())
+
+
+def test_store_carries_names_units_and_wavelengths(smoke_collection):
+    import zarr
+
+    root = zarr.open_group(str(smoke_collection / "radiance.zarr"), mode="r")
+    arrays = _resolved(smoke_collection)["arrays"]
+    assert any(p.startswith("plates/") for p in arrays) and any(p.startswith("insets/") for p in arrays)
+    for path in arrays:
+        arr = root[path]
+        assert arr.metadata.dimension_names == ("y", "x", "wavelength")
+        assert arr.attrs["units"] == "W sr-1 m-2 nm-1"
+        np.testing.assert_array_equal(arr.attrs["wavelengths_nm"], np.arange(400, 701, 10))
+        assert arr.shape[2] == 31 and arr.dtype == np.float32
+        assert len(arr.attrs["extent_tan"]) == 4
+
+
+def test_groundtruth_is_valid_coco_with_boxes_inside(smoke_collection, smoke_manifest):
+    from pycocotools.coco import COCO
+
+    coco = COCO(str(smoke_collection / "groundtruth.json"))
+    n = smoke_manifest.environments * len(smoke_manifest.distances_m)
+    assert len(coco.getImgIds()) == n and len(coco.getAnnIds(catIds=[3])) == n
+    for img in coco.dataset["images"]:
+        assert {"distance_m", "environment_id", "scene_id"} <= set(img)
+        (ann,) = coco.loadAnns(coco.getAnnIds(imgIds=[img["id"]]))
+        x, y, w, h = ann["bbox"]
+        assert ann["category_id"] == 3 and w > 0 and h > 0
+        assert 0 <= x and 0 <= y and x + w <= img["width"] and y + h <= img["height"]
+    # Farther cars are smaller within each environment (paired design).
+    for env in {i["environment_id"] for i in coco.dataset["images"]}:
+        imgs = sorted((i for i in coco.dataset["images"] if i["environment_id"] == env), key=lambda i: i["distance_m"])
+        widths = [coco.loadAnns(coco.getAnnIds(imgIds=[i["id"]]))[0]["bbox"][2] for i in imgs]
+        assert widths == sorted(widths, reverse=True)
+
+
+def test_same_seed_same_bytes_other_seed_different(smoke_collection, smoke_manifest, tmp_path):
+    again = generate(smoke_manifest, tmp_path / "again")
+    assert _resolved(again)["arrays"] == _resolved(smoke_collection)["arrays"]
+    assert (again / "groundtruth.json").read_bytes() == (smoke_collection / "groundtruth.json").read_bytes()
+    assert Collection.open(again).verify() == []
+    reseeded = smoke_manifest.model_copy(update={"seed": smoke_manifest.seed + 1, "environments": 1})
+    other = generate(reseeded, tmp_path / "other")
+    other_hashes = set(_resolved(other)["arrays"].values())
+    assert not other_hashes & set(_resolved(smoke_collection)["arrays"].values())
+
+
+def test_killed_run_resumes_bit_identical_with_more_workers(smoke_collection, smoke_manifest, tmp_path):
+    out = tmp_path / "resumed"
+
+    def stop_after_three(done, total, key):
+        if done >= 3 and key is not None:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        generate(smoke_manifest, out, progress=stop_after_three)
+    assert not (out / "manifest.resolved.yaml").exists()
+    with pytest.raises(CollectionError, match="missing"):
+        Collection.open(out)
+    # A torn progress record is redone, not trusted.
+    records = sorted((out / "progress").glob("env*.json"))
+    records[0].write_text("{ torn")
+    generate(smoke_manifest, out, workers=2, threads=1)
+    assert _resolved(out)["arrays"] == _resolved(smoke_collection)["arrays"]
+    assert (out / "groundtruth.json").read_bytes() == (smoke_collection / "groundtruth.json").read_bytes()
+
+
+def test_refuses_to_mix_manifests(smoke_collection, smoke_manifest, tmp_path):
+    out = tmp_path / "mixed"
+    shutil.copytree(smoke_collection, out)
+    with pytest.raises(CollectionError, match="another manifest"):
+        generate(smoke_manifest.model_copy(update={"seed": 1}), out)
+
+
+def test_verify_finds_a_corrupted_chunk(smoke_collection, tmp_path):
+    out = tmp_path / "corrupt"
+    shutil.copytree(smoke_collection, out)
+    path = next(iter(_resolved(out)["arrays"]))
+    chunk = next(p for p in (out / "radiance.zarr" / path).rglob("*") if p.is_file() and p.name != "zarr.json")
+    data = bytearray(chunk.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    chunk.write_bytes(bytes(data))
+    assert path in Collection.open(out).verify()
+
+
+def test_conditions_are_linear_mixes_of_light_groups(smoke_collection):
+    c = Collection.open(smoke_collection)
+    scene = c.scenes()[0].scene_id
+    day, night = c.radiance(scene, "day"), c.radiance(scene, "night")
+    both = c.radiance(scene, {"sky_day": 1.0, "sky_night": 1.0, "car_lights": 1.0})
+    for a, b, ab in zip(day.layers, night.layers, both.layers):
+        np.testing.assert_allclose(a.radiance + b.radiance, ab.radiance, rtol=1e-5, atol=1e-12)
+    assert len(day.layers) == 2 and day.layers[1].extent.width < day.layers[0].extent.width
+    # The inset is finer than the plate.
+    assert day.layers[1].pixel_tan[0] < day.layers[0].pixel_tan[0]
+    with pytest.raises(CollectionError, match="unknown condition"):
+        c.radiance(scene, "dawn")
+
+
+def test_open_refuses_incomplete_folders(tmp_path):
+    with pytest.raises(CollectionError, match="no such"):
+        Collection.open(tmp_path / "nothing")
+    (tmp_path / "half").mkdir()
+    with pytest.raises(CollectionError, match="missing"):
+        Collection.open(tmp_path / "half")
+    (tmp_path / "half" / "manifest.resolved.yaml").write_text(": not yaml : [")
+    (tmp_path / "half" / "groundtruth.json").write_text("{}")
+    (tmp_path / "half" / "radiance.zarr").mkdir()
+    with pytest.raises(CollectionError, match="corrupted"):
+        Collection.open(tmp_path / "half")

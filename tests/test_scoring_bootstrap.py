@@ -1,0 +1,66 @@
+"""Bootstrap of OD50 over environments: the fast re-accumulation equals COCOeval, seeding, scaling."""
+
+import numpy as np
+import pytest
+
+from benchmark.scoring import ap_by_distance, bootstrap_od50, resample_environments
+from benchmark.scoring.bootstrap import _match_tables, weighted_ap
+from benchmark.scoring.synthetic import synthetic_collection
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_weighted_accumulate_equals_cocoeval_on_resamples(seed):
+    gt, dets = synthetic_collection(8, seed=seed, empty_distance_m=200.0)
+    envs = sorted({im["environment_id"] for im in gt["images"]})
+    tables = _match_tables(gt, dets, 3, {e: k for k, e in enumerate(envs)})
+    rng = np.random.default_rng(seed)
+    for trial in range(4):
+        sample = rng.integers(0, len(envs), len(envs)) if trial else np.arange(len(envs))
+        rgt, rdets = resample_environments(gt, dets, [envs[k] for k in sample])
+        assert len(rgt["images"]) == len(envs) * 6 and len({im["id"] for im in rgt["images"]}) == len(rgt["images"])
+        oracle = ap_by_distance(rgt, rdets, backend="pycocotools")
+        w = np.bincount(sample, minlength=len(envs))
+        for row in oracle:
+            ap, ap50 = weighted_ap(tables[row["distance_m"]], w)
+            assert ap == pytest.approx(row["ap"], abs=1e-12)
+            assert ap50 == pytest.approx(row["ap50"], abs=1e-12)
+
+
+def test_same_seed_same_result_and_other_seed_differs():
+    gt, dets = synthetic_collection(10, seed=4)
+    a = bootstrap_od50(gt, dets, n_resamples=200, seed=7)
+    b = bootstrap_od50(gt, dets, n_resamples=200, seed=7)
+    c = bootstrap_od50(gt, dets, n_resamples=200, seed=8)
+    assert a == b
+    assert a["sd_m"] != c["sd_m"]
+    assert a["n_resamples"] == 200 and a["n_environments"] == 10
+    lo, hi = a["ci95_m"]
+    assert lo < a["od50_m"] < hi
+    assert 0 < a["sd_m"] < hi - lo
+
+
+def test_sd_shrinks_with_more_environments():
+    # SD of a mean-like statistic scales ~ 1/sqrt(n): 4x the environments ~ half the SD
+    small = [bootstrap_od50(*synthetic_collection(10, seed=s), n_resamples=200, seed=0)["sd_m"] for s in range(3)]
+    large = [bootstrap_od50(*synthetic_collection(40, seed=s), n_resamples=200, seed=0)["sd_m"] for s in range(3)]
+    assert np.mean(large) < 0.75 * np.mean(small)
+
+
+def test_point_estimate_is_od50_of_full_set_and_errors():
+    gt, dets = synthetic_collection(6, seed=2)
+    res = bootstrap_od50(gt, dets, n_resamples=50, seed=0, backend="pycocotools")
+    from benchmark.scoring import od50
+
+    rows = ap_by_distance(gt, dets)
+    assert res["od50_m"] == pytest.approx(od50([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
+    with pytest.raises(ValueError, match="n_resamples"):
+        bootstrap_od50(gt, dets, n_resamples=1)
+    one_env = {**gt, "images": [im for im in gt["images"] if im["environment_id"] == 0]}
+    with pytest.raises(ValueError, match="two or more environments"):
+        bootstrap_od50(one_env, [], n_resamples=10)
+
+
+def test_no_detections_bootstrap():
+    gt, _ = synthetic_collection(4, seed=0)
+    res = bootstrap_od50(gt, [], n_resamples=20)
+    assert res["od50_m"] == 0.0 and res["sd_m"] == 0.0
