@@ -35,7 +35,8 @@ def run(
     out: Annotated[Path, typer.Option("--out", "-o", help="results folder")],
     condition: Annotated[str, typer.Option(help="a condition of the collection (day, dusk, night)")] = "day",
     model: Annotated[str, typer.Option(help="detector: registry name or .onnx path")] = "yolov5n-dynamic",
-    input_size: Annotated[str, typer.Option(help="native | multiscale | an integer such as 640")] = "native",
+    input_size: Annotated[str, typer.Option(
+        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = "multiscale",
     seed: Annotated[int, typer.Option(help="sensor noise seed")] = 0,
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the camera's sRGB images")] = True,

@@ -74,7 +74,8 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
         timings.add("camera", t)
         exposures[scene.scene_id] = capture.exposure_s
         t = time.perf_counter()
-        (found,) = detector.detect([capture.rgb8], conf_threshold=AP_SCORE_THRESHOLD)
+        # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
+        (found,) = detector.detect([capture.rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
         timings.add("detect", t)
         for d in found:
             x1, y1, x2, y2 = (float(v) for v in d.box_xyxy)
@@ -85,7 +86,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
             })
         if save_images:
             t = time.perf_counter()
-            Image.fromarray(capture.rgb8).save(out_dir / "images" / f"{scene.scene_id}.png")
+            Image.fromarray(capture.rgb8).save(out_dir / "images" / f"{scene.scene_id}.png", compress_level=1)
             timings.add("save_images", t)
         if progress:
             progress(i + 1, len(scenes))
@@ -105,7 +106,8 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
         },
         "condition": condition,
         "detector": {"name": detector.name, "family": detector.family, "sha256": detector.sha256,
-                     "input_size": detector.input_size, "score_threshold": AP_SCORE_THRESHOLD},
+                     "input_size": detector.input_size, "score_threshold": AP_SCORE_THRESHOLD,
+                     "multi_label": True},
         "collection": {"name": collection.name, "protocol": collection.protocol,
                        "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
         "seed": seed,

@@ -1,0 +1,175 @@
+"""The shared ONNX pipeline: placement, batched onnxruntime inference, decode, NMS, un-placement.
+
+Family conventions live in ``yolov5``, ``yolov8``, ``yolox``; input-size policies in
+``policy``. Same-size canvases are stacked into one batch when the model's batch axis is
+dynamic (at most ``MAX_BATCH_PX`` pixels per run, to bound memory).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import onnxruntime as ort
+
+from benchmark.detectors import yolov5, yolov8, yolox
+from benchmark.detectors.base import COCO80_NAMES, Detection, DetectorError
+from benchmark.detectors.family import N_CLASSES, Family, grid_cells
+from benchmark.detectors.letterbox import Placement, letterbox, pad_to_stride
+from benchmark.detectors.nms import batched_nms
+from benchmark.detectors.policy import Pass, parse_input_size, plan_passes
+
+FAMILIES: dict[str, Family] = {f.name: f for f in (yolov5.FAMILY, yolov8.FAMILY, yolox.FAMILY)}
+MAX_BATCH_PX = 4_000_000
+_PROBE_HW = (64, 64)  # a dynamic model is probed at this size to learn its output layout
+
+
+def open_session(path: Path, threads: int | None) -> ort.InferenceSession:
+    """onnxruntime CPU session; ``threads`` sets intra-op threads (None = onnxruntime default)."""
+    opts = ort.SessionOptions()
+    opts.log_severity_level = 3
+    if threads is not None:
+        opts.intra_op_num_threads = int(threads)
+        opts.inter_op_num_threads = 1
+    try:
+        return ort.InferenceSession(str(path), sess_options=opts, providers=["CPUExecutionProvider"])
+    except Exception as exc:  # onnxruntime raises several types for unreadable files
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise DetectorError(f"not a usable ONNX model: {path} ({first[:160]})") from None
+
+
+def _static_hw(session: ort.InferenceSession) -> tuple[int, int] | None:
+    shape = session.get_inputs()[0].shape
+    if len(shape) != 4 or shape[1] not in (3, "3"):
+        raise DetectorError(f"expected an image input [batch, 3, H, W], got {shape}")
+    h, w = shape[2], shape[3]
+    return (h, w) if isinstance(h, int) and isinstance(w, int) else None
+
+
+def _output_layout(session: ort.InferenceSession, path: Path) -> tuple[tuple[int, int], tuple[int, ...]]:
+    """(canvas_hw, output shape) at the model's static size, or at a probe size for a dynamic model."""
+    hw = _static_hw(session)
+    out_shape = session.get_outputs()[0].shape
+    if hw is not None and all(isinstance(d, int) for d in out_shape):
+        return hw, tuple(out_shape)
+    hw = hw or _PROBE_HW
+    x = np.zeros((1, 3, *hw), dtype=np.float32)
+    try:
+        out = session.run(None, {session.get_inputs()[0].name: x})[0]
+    except Exception as exc:
+        raise DetectorError(f"{path}: model failed on a {hw[0]}x{hw[1]} probe input ({str(exc).splitlines()[0][:120]})") from None
+    return hw, tuple(out.shape)
+
+
+def infer_family(session: ort.InferenceSession, path: Path) -> str:
+    """Family from the output shape: [., 84, N] YOLOv8; [., N, 85] YOLOv5 (N = 3·cells) or YOLOX (N = cells)."""
+    hw, shape = _output_layout(session, path)
+    cells = grid_cells(*hw)
+    if len(shape) == 3 and shape[1] == 4 + N_CLASSES and shape[2] == cells:
+        return "yolov8"
+    if len(shape) == 3 and shape[2] == 5 + N_CLASSES:
+        if shape[1] == 3 * cells:
+            return "yolov5"
+        if shape[1] == cells:
+            return "yolox"
+    raise DetectorError(
+        f"wrong output shape {list(shape)} for a {hw[0]}x{hw[1]} input in {path}: expected "
+        f"[b,{3 * cells},85] (YOLOv5), [b,{cells},85] (YOLOX) or [b,84,{cells}] (YOLOv8), 80 COCO classes"
+    )
+
+
+def check_family(session: ort.InferenceSession, path: Path, family: Family) -> None:
+    hw, shape = _output_layout(session, path)
+    rows = family.expected_rows(hw)
+    want = (rows, 5 + N_CLASSES) if family.channels_last_output else (4 + N_CLASSES, rows)
+    if len(shape) != 3 or tuple(shape[1:]) != want:
+        raise DetectorError(f"wrong output shape {list(shape)} for a {family.name} model in {path}: expected [b,{want[0]},{want[1]}]")
+
+
+class OnnxDetector:
+    """A YOLO-family ONNX model with an input-size policy (see :func:`load_detector`)."""
+
+    def __init__(self, session: ort.InferenceSession, *, path: Path, name: str, family: str, sha256: str, input_size: str | int):
+        self.session = session
+        self.path = Path(path)
+        self.name = name
+        self.family = family
+        self.sha256 = sha256
+        self.input_size = parse_input_size(input_size)
+        self._family = FAMILIES[family]
+        self._input_name = session.get_inputs()[0].name
+        self._static_hw = _static_hw(session)
+        self._dynamic_batch = not isinstance(session.get_inputs()[0].shape[0], int)
+        self.passes: list[Pass] = plan_passes(self.input_size, self._static_hw, name)
+
+    def __repr__(self) -> str:
+        return f"OnnxDetector(name={self.name!r}, family={self.family!r}, input_size={self.input_size!r}, passes={[p.label for p in self.passes]})"
+
+    def _place(self, image: np.ndarray, p: Pass) -> tuple[np.ndarray, Placement]:
+        if p.size_px is None:
+            return pad_to_stride(image, self._family.placement)
+        return letterbox(image, (p.size_px, p.size_px), self._family.placement)
+
+    def _run(self, canvases: list[np.ndarray]) -> list[np.ndarray]:
+        """Raw outputs, one per canvas (all canvases the same shape)."""
+        fam = self._family
+        h, w = canvases[0].shape[:2]
+        per_run = max(1, MAX_BATCH_PX // (h * w)) if self._dynamic_batch else 1
+        outs: list[np.ndarray] = []
+        for start in range(0, len(canvases), per_run):
+            x = np.stack([fam.to_input(c) for c in canvases[start : start + per_run]])
+            y = self.session.run(None, {self._input_name: x})[0]
+            outs.extend(list(y))
+        return outs
+
+    def _pass(self, images: Sequence[np.ndarray], p: Pass, conf: float, iou: float, max_det: int, multi_label: bool):
+        placed = [self._place(im, p) for im in images]
+        groups: dict[tuple[int, int], list[int]] = defaultdict(list)
+        for i, (canvas, _) in enumerate(placed):
+            groups[canvas.shape[:2]].append(i)
+        results: list = [None] * len(images)
+        for hw, idx in groups.items():
+            for i, out in zip(idx, self._run([placed[i][0] for i in idx])):
+                boxes, scores, cls = self._family.decode(out, hw, conf, multi_label)
+                if self._family.max_candidates and len(scores) > self._family.max_candidates:
+                    top = np.argsort(-scores, kind="stable")[: self._family.max_candidates]
+                    boxes, scores, cls = boxes[top], scores[top], cls[top]
+                keep = batched_nms(boxes, scores, cls, iou, max_det)
+                results[i] = (placed[i][1].to_image(boxes[keep]), scores[keep], cls[keep])
+        return results
+
+    def detect(
+        self,
+        images: Sequence[np.ndarray],
+        *,
+        conf_threshold: float = 0.001,
+        iou_threshold: float = 0.45,
+        max_det: int = 300,
+        multi_label: bool = False,
+    ) -> list[list[Detection]]:
+        """Detections per RGB uint8 (H, W, 3) image, best score first, boxes in image pixels.
+
+        ``multi_label`` keeps every class above ``conf_threshold`` for a box (YOLOv5
+        ``val.py``); the default keeps the best class only (``detect.py``).
+        """
+        for k, im in enumerate(images):
+            if not (isinstance(im, np.ndarray) and im.ndim == 3 and im.shape[2] == 3 and im.dtype == np.uint8):
+                raise ValueError(f"images[{k}] must be an RGB uint8 array (H, W, 3), got {getattr(im, 'dtype', type(im))} {getattr(im, 'shape', '')}")
+        per_pass = [self._pass(images, p, conf_threshold, iou_threshold, max_det, multi_label) for p in self.passes]
+        out: list[list[Detection]] = []
+        for i in range(len(images)):
+            boxes = np.concatenate([r[i][0] for r in per_pass])
+            scores = np.concatenate([r[i][1] for r in per_pass])
+            cls = np.concatenate([r[i][2] for r in per_pass])
+            if len(per_pass) > 1:  # multiscale: merge the passes by class-wise NMS
+                keep = batched_nms(boxes, scores, cls, iou_threshold, max_det)
+                boxes, scores, cls = boxes[keep], scores[keep], cls[keep]
+            out.append(
+                [
+                    Detection(int(c), COCO80_NAMES[int(c)], float(s), tuple(float(v) for v in b))
+                    for b, s, c in zip(boxes, scores, cls)
+                ]
+            )
+        return out

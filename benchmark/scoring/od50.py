@@ -1,0 +1,60 @@
+"""OD50: the distance (m) at which AP falls to 0.5 (Liu et al. 2023, "object detection distance").
+
+Rules, applied to the points sorted by distance (NaN AP points dropped; at least two needed):
+
+1. **Crossing.** The first *downward* crossing from the near end — the first pair of
+   neighbours with AP(d_i) >= 0.5 > AP(d_{i+1}) — is interpolated linearly. A curve
+   that crosses 0.5 more than once (e.g. 0.7, 0.4, 0.6, 0.3) counts its first downward
+   crossing: OD50 is the range up to which detection is reliable, and a later recovery
+   (noise, or a policy that favours mid distances) does not make the nearer gap reliable.
+   An upward crossing (AP below 0.5 at the near end, above further out) is not a fall
+   to 0.5 and is skipped.
+2. **Ends above 0.5** (no downward crossing, last point >= 0.5): linear extrapolation
+   beyond the far end from the last two points. If that line does not fall
+   (flat or rising), AP never reaches 0.5 on it: OD50 = +inf.
+3. **All below 0.5**: linear extrapolation below the near end from the first two points,
+   clipped at 0 m. If that line does not fall (flat or rising), OD50 = 0 m: the camera
+   does not reach AP 0.5 at any distance.
+
+Rule 1 with rules 2-3 (plain linear extrapolation from the nearest two points)
+reproduces the paper's values; the flat/rising cases are our additions so that OD50 is
+always defined (inf or a number >= 0, never NaN) for bootstrapping.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+AP_LEVEL = 0.5
+
+
+def _line_at(d0: float, a0: float, d1: float, a1: float, level: float) -> float:
+    return d0 + (level - a0) * (d1 - d0) / (a1 - a0)
+
+
+def od50(distances_m, ap, *, level: float = AP_LEVEL) -> float:
+    """Distance in metres where AP crosses ``level`` (0.5); see the module docstring for the rules."""
+    d = np.asarray(distances_m, dtype=np.float64).ravel()
+    a = np.asarray(ap, dtype=np.float64).ravel()
+    if d.shape != a.shape:
+        raise ValueError(f"distances_m and ap must have the same length, got {d.size} and {a.size}")
+    ok = np.isfinite(a) & np.isfinite(d)
+    d, a = d[ok], a[ok]
+    if d.size < 2:
+        raise ValueError(f"od50 needs AP at two or more distances, got {d.size} finite points")
+    order = np.argsort(d, kind="stable")
+    d, a = d[order], a[order]
+    if np.any(np.diff(d) == 0):
+        raise ValueError(f"distances_m must be distinct, got {d.tolist()}")
+    down = np.nonzero((a[:-1] >= level) & (a[1:] < level))[0]
+    if down.size:
+        i = int(down[0])
+        return float(_line_at(d[i], a[i], d[i + 1], a[i + 1], level))
+    if a[-1] >= level:  # never falls below the level within the range: extrapolate beyond it
+        if a[-1] >= a[-2]:
+            return float("inf")
+        return float(_line_at(d[-2], a[-2], d[-1], a[-1], level))
+    # all points below the level: extrapolate below the near end
+    if a[1] >= a[0]:
+        return 0.0
+    return float(max(0.0, _line_at(d[0], a[0], d[1], a[1], level)))
