@@ -5,8 +5,8 @@ A scene is a stack of :class:`RadianceLayer` s: the first (the *plate*) covers t
 whole reference field of view at the collection's reference sampling; the later ones
 (*insets*) cover smaller windows around the car at a finer angular sampling and are
 pasted over the plate. :meth:`SpectralScene.resample` turns the stack into a single
-uniform grid of any size (e.g. a camera's pixel grid) by exact area overlap, so
-radiance (and hence flux) is conserved whatever the two samplings.
+uniform grid of any size (e.g. a camera's pixel grid): area averaging where a layer
+is finer than the grid (flux conserved), linear interpolation where it is coarser.
 """
 
 from __future__ import annotations
@@ -72,27 +72,61 @@ class SpectralScene:
     def resample(self, cols: int, rows: int, extent: TanExtent | None = None) -> np.ndarray:
         """Composite the layers onto a uniform (rows, cols, bands) float32 grid.
 
-        Each output pixel is the area-weighted mean of the layer pixels it overlaps
-        (exact box resampling), so a uniform field stays uniform and flux is
-        conserved. ``extent`` defaults to the plate's (the full field of view).
+        Where a layer is finer than the target grid, each output pixel is the
+        area-weighted mean of the layer pixels it overlaps (exact box resampling:
+        flux is conserved); where it is coarser, values are interpolated linearly
+        between sample centres. A uniform field stays uniform either way.
+        ``extent`` defaults to the plate's (the full field of view).
         """
         extent = extent or self.extent
-        out = _resample_layer(self.layers[0], cols, rows, extent)
+        out = _apply(*_weights(self.layers[0], cols, rows, extent), self.layers[0].radiance)
         for inset in self.layers[1:]:
-            wx = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
-                                 extent.x0, extent.x1, cols)
-            wy = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
-                                 extent.y0, extent.y1, rows)
-            coverage = np.outer(np.asarray(wy.sum(axis=1)).ravel(), np.asarray(wx.sum(axis=1)).ravel())
-            pasted = _apply(wy, wx, inset.radiance)
-            out = out * (1.0 - coverage[..., None]).astype(np.float32) + pasted
+            # Where the inset covers a target pixel, its radiance replaces the plate's;
+            # partly covered pixels blend by covered area.
+            cover_x = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
+                                      extent.x0, extent.x1, cols)
+            cover_y = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
+                                      extent.y0, extent.y1, rows)
+            coverage = np.outer(np.asarray(cover_y.sum(axis=1)).ravel(), np.asarray(cover_x.sum(axis=1)).ravel())
+            values = _apply(*_weights(inset, cols, rows, extent), inset.radiance)
+            out = out * (1.0 - coverage[..., None]).astype(np.float32) + values * coverage[..., None].astype(np.float32)
         return out
 
 
-def _resample_layer(layer: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> np.ndarray:
-    wx = _overlap_matrix(layer.extent.x0, layer.extent.x1, layer.radiance.shape[1], extent.x0, extent.x1, cols)
-    wy = _overlap_matrix(layer.extent.y0, layer.extent.y1, layer.radiance.shape[0], extent.y0, extent.y1, rows)
-    return _apply(wy, wx, layer.radiance)
+def _weights(layer: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Resampling matrices (rows, cols axes) from a layer onto the target grid: exact
+    area overlap where the layer is finer than the target (downsampling: flux is
+    conserved), linear interpolation between sample centres where it is coarser
+    (upsampling: no blocky pixel edges in the image)."""
+    n_rows, n_cols = layer.radiance.shape[:2]
+    e = layer.extent
+    wy = _axis_matrix(e.y0, e.y1, n_rows, extent.y0, extent.y1, rows)
+    wx = _axis_matrix(e.x0, e.x1, n_cols, extent.x0, extent.x1, cols)
+    return wy, wx
+
+
+def _axis_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: float, n_dst: int) -> sp.csr_matrix:
+    src_pitch, dst_pitch = (src1 - src0) / n_src, (dst1 - dst0) / n_dst
+    if src_pitch <= dst_pitch:
+        rows = _overlap_matrix(src0, src1, n_src, dst0, dst1, n_dst)
+        # Normalise partly covered target cells by their covered part (value, not flux).
+        norm = np.asarray(rows.sum(axis=1)).ravel()
+        return sp.diags(np.where(norm > 0, 1.0 / np.maximum(norm, 1e-300), 0.0)) @ rows
+    return _linear_matrix(src0, src1, n_src, dst0, dst1, n_dst)
+
+
+def _linear_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: float, n_dst: int) -> sp.csr_matrix:
+    """Linear interpolation between source sample centres (clamped at the ends)."""
+    centres = dst0 + (np.arange(n_dst) + 0.5) * (dst1 - dst0) / n_dst
+    pos = np.clip((centres - src0) / (src1 - src0) * n_src - 0.5, 0.0, n_src - 1)
+    lo = np.minimum(np.floor(pos).astype(int), max(n_src - 2, 0))
+    frac = pos - lo
+    hi = np.minimum(lo + 1, n_src - 1)
+    idx = np.arange(n_dst)
+    return sp.csr_matrix(
+        (np.concatenate([1.0 - frac, frac]), (np.concatenate([idx, idx]), np.concatenate([lo, hi]))),
+        shape=(n_dst, n_src),
+    )
 
 
 def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, cube: np.ndarray) -> np.ndarray:
