@@ -2,7 +2,8 @@
 
 Units of work are the plates (one per environment: its background without the car,
 once per light group) and the insets (one per scene: a window around the car at
-finer angular sampling, once per light group). Each unit writes its own zarr arrays
+finer angular sampling, once per light group, plus a whole frame of the car's own
+lamps at plate sampling, since their light reaches far beyond the window). Each unit writes its own zarr arrays
 and then a small record under ``progress/``; a rerun skips units whose record exists,
 so a killed run resumes, and because every unit is a pure function of the manifest
 the result is bit-identical to an uninterrupted run, whatever the number of workers.
@@ -108,14 +109,20 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
                            e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
         record.update(box_tan=list(box), inset_scale=k, pose=asdict(pose),
                       bbox_xywh=box_tan_to_xywh(box, ref_w, ref_h))
-    for i, group in enumerate(groups):
+    jobs = [(kind, group, film, spp, extent) for group in groups]
+    if unit.kind == "inset" and "car_lights" in groups:
+        # The car's lamps light the road far outside its inset (an oncoming car's beams
+        # reach the camera): that group also gets a whole frame at plate sampling.
+        jobs.append(("frames", "car_lights", Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT))
+    for i, (job_kind, group, job_film, job_spp, job_extent) in enumerate(jobs):
         if not scene_mod.has_emitters(parts, group):
             continue
-        sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
+        sd = scene_mod.scene_dict(env, parts, group, job_film, spp=job_spp, seed=unit.seed + 7919 * i,
                                   max_depth=manifest.render.max_depth)
-        cube = render_radiance(sd, spp)
-        sha = write_radiance(root, kind, unit.key, group, cube, extent, {"spp": spp, "seed": unit.seed})
-        record["arrays"][f"{kind}/{unit.key}/{group}"] = sha
+        cube = render_radiance(sd, job_spp)
+        sha = write_radiance(root, job_kind, unit.key, group, cube, job_extent,
+                             {"spp": job_spp, "seed": unit.seed})
+        record["arrays"][f"{job_kind}/{unit.key}/{group}"] = sha
     record["seconds"] = round(time.perf_counter() - started, 3)
     return record
 
@@ -146,7 +153,7 @@ def _prepare(root: Path, manifest: Manifest) -> None:
     zroot = zarr.open_group(str(root / RADIANCE_STORE), mode="a")
     zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
                         "dimension_names": ["y", "x", "wavelength"]})
-    for name in ("plates", "insets"):
+    for name in ("plates", "insets", "frames"):
         zroot.require_group(name)
 
 

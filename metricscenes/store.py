@@ -5,6 +5,7 @@ Layout of a collection folder::
     radiance.zarr/                      zarr v3
       plates/<env>/<light_group>        (y, x, wavelength) float32, whole field of view
       insets/<scene>/<light_group>      (y, x, wavelength) float32, a window around the car
+      frames/<scene>/car_lights         (y, x, wavelength) float32, the car's lamps over the whole view
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, sha256 of every array
     progress/<unit>.json                one record per finished unit of work (resume)
@@ -171,10 +172,12 @@ class Collection:
             return dict(self.conditions[condition])
         return dict(condition)
 
-    def _mix(self, kind: str, unit: str, weights: dict[str, float]) -> RadianceLayer | None:
+    def _mix(self, kind: str, unit: str, weights: dict[str, float], required: bool = True) -> RadianceLayer | None:
         group = self._group()
         path = f"{kind}/{unit}"
         if path not in group:
+            if not required:
+                return None
             raise CollectionError(f"{self.root}: {path} is missing from {RADIANCE_STORE}")
         node = group[path]
         total, extent = None, None
@@ -202,10 +205,13 @@ class Collection:
         img = self._images[scene_id]
         weights = self._weights(condition)
         plate = self._mix("plates", f"env{img['environment_id']:03d}", weights)
-        inset = self._mix("insets", scene_id, weights)
-        layers = tuple(layer for layer in (plate, inset) if layer is not None)
         if plate is None:
             raise CollectionError(f"{self.root}: scene {scene_id} has no plate")
+        frame = self._mix("frames", scene_id, weights, required=False)
+        if frame is not None:
+            plate = RadianceLayer(plate.radiance + frame.radiance, plate.extent)
+        inset = self._mix("insets", scene_id, weights)
+        layers = tuple(layer for layer in (plate, inset) if layer is not None)
         return SpectralScene(
             layers=layers,
             metadata={"scene_id": scene_id, "condition": condition, "distance_m": img["distance_m"],

@@ -22,7 +22,7 @@ def test_store_carries_names_units_and_wavelengths(smoke_collection):
 
     root = zarr.open_group(str(smoke_collection / "radiance.zarr"), mode="r")
     arrays = _resolved(smoke_collection)["arrays"]
-    assert any(p.startswith("plates/") for p in arrays) and any(p.startswith("insets/") for p in arrays)
+    assert {p.split("/")[0] for p in arrays} == {"plates", "insets", "frames"}
     for path in arrays:
         arr = root[path]
         assert arr.metadata.dimension_names == ("y", "x", "wavelength")
