@@ -14,7 +14,7 @@ from rich.table import Table
 from benchmark.cli_cameras import app as cameras_app
 from benchmark import cli_detect
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
 app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show, measure MTF50.")
 cli_detect.register(app)

@@ -15,7 +15,7 @@ from rich.table import Table
 
 from metricscenes import __version__
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="Seeded metric driving scenes rendered as spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).")
 console = Console()
 err = Console(stderr=True)
@@ -159,6 +159,35 @@ def preview(
         fail(str(exc))
     path = contact_sheet(tiles, labels, columns, out or collection / f"preview-{condition}.png")
     console.print(f"wrote {path}")
+
+
+assets_app = typer.Typer(add_completion=False, no_args_is_help=True, help="The procedural asset library.")
+app.add_typer(assets_app, name="assets")
+
+
+@assets_app.command("list")
+def assets_list(as_json: Annotated[bool, typer.Option("--json")] = False) -> None:
+    """List the cars, roads and skies with their main parameters."""
+    from dataclasses import asdict
+
+    from metricscenes.assets import cars, roads, skies
+
+    library = {
+        "cars": [asdict(c) for c in cars.car_library()],
+        "roads": [asdict(r) for r in roads.road_library()],
+        "skies": [{**asdict(s), "light_group": s.light_group} for s in skies.sky_library()],
+    }
+    if as_json:
+        print(json.dumps(library, indent=1))
+        return
+    for kind, rows in library.items():
+        table = Table(title=f"{kind} ({len(rows)})")
+        columns = list(rows[0])[:8]
+        for col in columns:
+            table.add_column(col)
+        for row in rows:
+            table.add_row(*(f"{row[c]:.3g}" if isinstance(row[c], float) else str(row[c]) for c in columns))
+        console.print(table)
 
 
 @app.callback(invoke_without_command=True)

@@ -66,3 +66,13 @@ def test_plan_is_seeded_paired_and_prefix_stable(smoke_manifest):
     other = smoke_manifest.model_copy(update={"seed": smoke_manifest.seed + 1})
     assert plan_collection(other) != a
     assert len({s.scene_id for s in a}) == len(a)
+
+
+def test_plan_draws_from_the_whole_asset_library():
+    from metricscenes import plan
+    from metricscenes.assets import cars, roads, skies
+
+    assert plan.N_CARS == len(cars.car_library())
+    assert plan.N_ROADS == len(roads.road_library())
+    for kind, ids in plan.SKY_IDS.items():
+        assert list(ids) == skies.skies_for(kind)
