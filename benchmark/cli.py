@@ -12,12 +12,13 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from benchmark.cli_cameras import app as cameras_app
-from benchmark import cli_detect
+from benchmark import cli_detect, cli_leaderboard
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
 app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show, measure MTF50.")
 cli_detect.register(app)
+cli_leaderboard.register(app)
 console = Console()
 err = Console(stderr=True)
 
@@ -51,8 +52,8 @@ def run(
     try:
         cam = load_camera(camera)
         col = Collection.open(collection)
-        if condition not in col.conditions:
-            fail(f"unknown condition {condition!r} (this collection has: {', '.join(col.conditions)})")
+        if condition not in col.condition_names:
+            fail(f"unknown condition {condition!r} (this collection has: {', '.join(col.condition_names)})")
         detector = load_detector(model, input_size=input_size, threads=threads)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])

@@ -94,6 +94,8 @@ def _plan_table(scenes: list[dict]) -> None:
 def info(
     collection: Annotated[Path, typer.Argument(help="collection folder")],
     as_json: Annotated[bool, typer.Option("--json")] = False,
+    photometry: Annotated[bool, typer.Option(
+        "--photometry", help="per scene and condition: lux at the camera, image-plane lux at f/2.4")] = False,
 ) -> None:
     """Summarise a collection."""
     from metricscenes.store import Collection
@@ -108,16 +110,35 @@ def info(
         "name": c.name, "protocol": c.protocol, "manifest_sha256": c.manifest_sha256,
         "package_version": c.resolved["package_version"], "scenes": len(scenes),
         "environments": len({s.environment_id for s in scenes}),
-        "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.conditions,
+        "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.condition_names,
         "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved["arrays"]),
         "radiance_units": "W sr-1 m-2 nm-1", "wavelengths_nm": [400, 700, 10], "store_bytes": size,
     }
+    if photometry:
+        summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.condition_names]
     if as_json:
         print(json.dumps(summary, indent=1))
         return
+    rows = summary.pop("photometry", [])
+    if rows:
+        _photometry_table(rows)
     table = Table(title=f"collection {c.name}", show_header=False)
     for k, v in summary.items():
         table.add_row(k, str(v))
+    console.print(table)
+
+
+def _photometry_table(rows: list[dict]) -> None:
+    """Mean over scenes, per condition."""
+    table = Table(title="photometry (mean over scenes)")
+    for col in ("condition", "lux at camera", "luminance cd/m²", "image-plane lux f/2.4"):
+        table.add_column(col, justify="right")
+    for cond in dict.fromkeys(r["condition"] for r in rows):
+        sel = [r for r in rows if r["condition"] == cond]
+        mean = {k: sum(r[k] for r in sel) / len(sel)
+                for k in ("illuminance_at_camera_lux", "mean_luminance_cd_m2", "image_plane_illuminance_lux")}
+        table.add_row(cond, f"{mean['illuminance_at_camera_lux']:.4g}", f"{mean['mean_luminance_cd_m2']:.4g}",
+                      f"{mean['image_plane_illuminance_lux']:.4g}")
     console.print(table)
 
 

@@ -83,7 +83,8 @@ def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
 def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None) -> dict:
     """Render and write one unit (runs in a worker process); return its progress record."""
     from metricscenes import scene as scene_mod
-    from metricscenes.render import Film, render_radiance, use_variant
+    from metricscenes.photometry import radiance_to_xyz
+    from metricscenes.render import Film, illuminance_meter, render_radiance, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
     use_variant(manifest.render.variant, threads)
@@ -123,6 +124,9 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         sha = write_radiance(root, job_kind, unit.key, group, cube, job_extent,
                              {"spp": job_spp, "seed": unit.seed})
         record["arrays"][f"{job_kind}/{unit.key}/{group}"] = sha
+        if unit.kind == "plate":
+            irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)
+            record.setdefault("illuminance_lux", {})[group] = round(float(radiance_to_xyz(irradiance)[1]), 9)
     record["seconds"] = round(time.perf_counter() - started, 3)
     return record
 
@@ -218,6 +222,9 @@ def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: 
         "manifest_sha256": manifest.sha256(),
         "manifest": manifest.model_dump(mode="json"),
         "arrays": arrays,
+        # Horizontal illuminance at the camera (0, 0, 1.5 m) per environment and light group.
+        "illuminance_lux": {key: records[key].get("illuminance_lux", {}) for key in sorted(records)
+                            if records[key]["kind"] == "plate"},
         "plan": [s.summary() for s in scenes],
     }
     write_atomic(root / GROUNDTRUTH_FILE, json.dumps(gt, indent=1))

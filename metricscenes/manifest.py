@@ -52,6 +52,23 @@ class RenderSettings(_Strict):
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral"] = "scalar_spectral"
 
 
+class IlluminanceSweep(_Strict):
+    """Conditions ``<base>@<level>lux``: the base condition with its ambient group scaled
+    so that the horizontal illuminance at the camera is ``level`` lux (the paper's
+    luminance sweep)."""
+
+    base: str
+    ambient_group: Literal[PLATE_LIGHT_GROUPS]  # type: ignore[valid-type]
+    levels_lux: tuple[float, ...] = Field(min_length=1)
+
+    @field_validator("levels_lux")
+    @classmethod
+    def _positive(cls, v: tuple[float, ...]) -> tuple[float, ...]:
+        if any(not (0 < lux < 2e5) for lux in v):
+            raise ValueError("every level must lie in (0, 200000) lux")
+        return v
+
+
 class Manifest(_Strict):
     """A collection definition (see docs/collections.md)."""
 
@@ -65,6 +82,7 @@ class Manifest(_Strict):
     render: RenderSettings
     light_groups: tuple[Literal[LIGHT_GROUPS], ...] = Field(min_length=1)  # type: ignore[valid-type]
     conditions: dict[str, dict[str, float]] = Field(min_length=1)
+    illuminance_sweep: IlluminanceSweep | None = None
 
     @field_validator("distances_m")
     @classmethod
@@ -86,6 +104,13 @@ class Manifest(_Strict):
                     )
                 if not (w >= 0.0):
                     raise ValueError(f"conditions.{name}.{group}: weight must be >= 0, got {w}")
+        sweep = self.illuminance_sweep
+        if sweep is not None:
+            if sweep.base not in self.conditions:
+                raise ValueError(f"illuminance_sweep.base: {sweep.base!r} is not a condition")
+            if self.conditions[sweep.base].get(sweep.ambient_group, 0.0) <= 0.0:
+                raise ValueError(f"illuminance_sweep.ambient_group: {sweep.ambient_group!r} does not light "
+                                 f"condition {sweep.base!r}")
         return self
 
     def sha256(self) -> str:

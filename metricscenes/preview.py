@@ -7,28 +7,11 @@ display rendering only; cameras model their own sensor and ISP (``benchmark``).
 
 from __future__ import annotations
 
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
-
-MAX_LUMINOUS_EFFICACY_LM_W = 683.0
-
-
-@lru_cache(maxsize=1)
-def _cmfs() -> np.ndarray:
-    import colour
-
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    return np.stack([np.interp(WAVELENGTHS_NM, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], axis=1)
-
-
-def radiance_to_xyz(radiance: np.ndarray) -> np.ndarray:
-    """Spectral radiance (..., 31) W·sr⁻¹·m⁻²·nm⁻¹ → XYZ (..., 3) with Y in cd/m²."""
-    return MAX_LUMINOUS_EFFICACY_LM_W * BAND_WIDTH_NM * (np.asarray(radiance, dtype=np.float64) @ _cmfs())
-
+from metricscenes.photometry import radiance_to_xyz
 
 def radiance_to_srgb8(radiance: np.ndarray, percentile: float = 99.0, white: float | None = None) -> np.ndarray:
     """Display rendering: (rows, cols, 31) radiance → (rows, cols, 3) uint8 sRGB.

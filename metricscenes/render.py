@@ -113,3 +113,30 @@ def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
     if not np.all(np.isfinite(image)):
         raise RenderError("render produced non-finite radiance")
     return image
+
+
+ILLUMINANCE_METER_SPP = 1024
+
+
+def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed: int = 0) -> np.ndarray:
+    """Horizontal spectral irradiance (31,) W·m⁻²·nm⁻¹ at (0, 0, height_m) in a scene dict.
+
+    A 2 cm white Lambertian patch (reflectance 1) is placed there and a radiance meter
+    looks down at it: E = π L. Unlike Mitsuba's ``irradiancemeter``, this catches
+    delta lights (the moon as a directional emitter) through emitter sampling. The
+    scene's own sensor is replaced.
+    """
+    import mitsuba as mi
+
+    scene = {k: v for k, v in scene_dict.items() if k != "sensor"}
+    scene["illuminance_patch"] = {
+        "type": "rectangle",
+        "to_world": mi.ScalarTransform4f().translate([0.0, 0.0, height_m]).scale(0.01),
+        "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": 1.0}},
+    }
+    scene["sensor"] = {
+        "type": "radiancemeter", "origin": [0.0, 0.0, height_m + 0.1], "direction": [0.0, 0.0, -1.0],
+        "film": spectral_film_dict(Film(1, 1)),
+        "sampler": {"type": "stratified", "sample_count": ILLUMINANCE_METER_SPP, "seed": int(seed) % 2**31},
+    }
+    return np.pi * render_radiance(scene, ILLUMINANCE_METER_SPP).reshape(-1)

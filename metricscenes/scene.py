@@ -83,15 +83,20 @@ def scene_dict(
         "sensor": sensor_dict(film, spp, seed),
     }
     scene.update(parts.shapes)
+    # Lamps are instantiated here, one by one: left as nested dicts, Mitsuba's loader
+    # registers their emitters in a varying order, and the emitter sampler (hence the
+    # image) then differs between identical runs.
+    import mitsuba as mi
+
     for lamp in parts.lamps:
         on = lamp.light_group == light_group
         if lamp.shape is not None:
             shape = dict(lamp.shape)
             if on:
                 shape["emitter"] = lamp.emitter
-            scene[f"lamp_{lamp.name}"] = shape
+            scene[f"lamp_{lamp.name}"] = mi.load_dict(shape)
         elif on:
-            scene[f"lamp_{lamp.name}"] = lamp.emitter
+            scene[f"lamp_{lamp.name}"] = mi.load_dict(lamp.emitter)
     if light_group in SKY_GROUPS:
         sky = skies.sky_spec(getattr(env, SKY_GROUPS[light_group]))
         for key, emitter in skies.sky_emitters(sky).items():

@@ -163,14 +163,58 @@ class Collection:
             self._zarr = zarr.open_group(str(self.root / RADIANCE_STORE), mode="r")
         return self._zarr
 
-    def _weights(self, condition: str | dict[str, float]) -> dict[str, float]:
-        if isinstance(condition, str):
-            if condition not in self.conditions:
-                raise CollectionError(
-                    f"unknown condition {condition!r} (this collection has: {', '.join(self.conditions)})"
-                )
+    @property
+    def condition_names(self) -> list[str]:
+        """The manifest's conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
+        sweep = self.manifest.get("illuminance_sweep")
+        levels = [f"{sweep['base']}@{lux:g}lux" for lux in sweep["levels_lux"]] if sweep else []
+        return list(self.conditions) + levels
+
+    def _weights(self, condition: str | dict[str, float], environment_id: int) -> dict[str, float]:
+        if not isinstance(condition, str):
+            return dict(condition)
+        if condition not in self.condition_names:
+            raise CollectionError(
+                f"unknown condition {condition!r} (this collection has: {', '.join(self.condition_names)})"
+            )
+        if condition in self.conditions:
             return dict(self.conditions[condition])
-        return dict(condition)
+        sweep = self.manifest["illuminance_sweep"]
+        level = float(condition.split("@")[1].removesuffix("lux"))
+        weights = dict(self.conditions[sweep["base"]])
+        group = sweep["ambient_group"]
+        measured = self.resolved["illuminance_lux"][f"env{environment_id:03d}"].get(group, 0.0)
+        if measured <= 0.0:
+            raise CollectionError(f"{self.root}: no {group} illuminance recorded for env{environment_id:03d}")
+        weights[group] = level / measured
+        return weights
+
+    def illuminance_lux(self, scene_id: str, condition: str | dict[str, float]) -> float:
+        """Horizontal illuminance at the camera (lux) under a condition: the light groups'
+        measured values, weighted (car lamps not included: they face the road)."""
+        env = self._image(scene_id)["environment_id"]
+        measured = self.resolved["illuminance_lux"][f"env{env:03d}"]
+        return float(sum(w * measured.get(g, 0.0) for g, w in self._weights(condition, env).items()))
+
+    def photometry(self, scene_id: str, condition: str | dict[str, float], f_number: float = 2.4) -> dict:
+        """Horizontal illuminance at the camera, mean scene luminance over the field of
+        view, and the mean image-plane illuminance of an ideal f/N lens."""
+        from metricscenes.photometry import image_plane_illuminance_lux, radiance_to_xyz
+
+        cols, rows = self.reference_grid
+        luminance = float(radiance_to_xyz(self.radiance(scene_id, condition).resample(cols, rows))[..., 1].mean())
+        return {
+            "scene_id": scene_id, "condition": condition if isinstance(condition, str) else dict(condition),
+            "illuminance_at_camera_lux": self.illuminance_lux(scene_id, condition),
+            "mean_luminance_cd_m2": luminance,
+            "f_number": f_number,
+            "image_plane_illuminance_lux": image_plane_illuminance_lux(luminance, f_number),
+        }
+
+    def _image(self, scene_id: str) -> dict:
+        if scene_id not in self._images:
+            raise CollectionError(f"unknown scene {scene_id!r}")
+        return self._images[scene_id]
 
     def _mix(self, kind: str, unit: str, weights: dict[str, float], required: bool = True) -> RadianceLayer | None:
         group = self._group()
@@ -200,10 +244,8 @@ class Collection:
         """The scene's spectral radiance under a condition (a name from the manifest, or
         light-group weights): the plate and the car's inset, each the weighted sum of its
         light groups' renders."""
-        if scene_id not in self._images:
-            raise CollectionError(f"unknown scene {scene_id!r}")
-        img = self._images[scene_id]
-        weights = self._weights(condition)
+        img = self._image(scene_id)
+        weights = self._weights(condition, img["environment_id"])
         plate = self._mix("plates", f"env{img['environment_id']:03d}", weights)
         if plate is None:
             raise CollectionError(f"{self.root}: scene {scene_id} has no plate")

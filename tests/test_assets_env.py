@@ -79,6 +79,11 @@ def test_road_parts_load_fast_and_stay_off_the_corridor(road_id):
             v = np.array(mi.traverse(parts.shapes[key])["vertex_positions"]).reshape(-1, 3)
             assert np.allclose(v[:, 2], roads.MARKING_Z_M)
             assert np.all(np.abs(v[:, 1] - yc) <= spec.half_paved_m)
+    # The paved road spans x = -5..395 m and the whole paved width, at z = 0.
+    v = np.concatenate([np.array(mi.traverse(s)["vertex_positions"]).reshape(-1, 3)
+                        for k, s in parts.shapes.items() if k.startswith("road_asphalt_")])
+    assert v[:, 0].min() == pytest.approx(-5.0) and v[:, 0].max() == pytest.approx(395.0)
+    assert np.ptp(v[:, 1]) == pytest.approx(2 * spec.half_paved_m, rel=1e-5) and np.all(v[:, 2] == 0)
     # Same seed, same geometry.
     again = roads.road_parts(spec, seed=7).shapes["road_asphalt_0" if "road_asphalt_0" in parts.shapes else "road_far"]
     first = parts.shapes["road_asphalt_0" if "road_asphalt_0" in parts.shapes else "road_far"]

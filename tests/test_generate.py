@@ -125,3 +125,21 @@ def test_open_refuses_incomplete_folders(tmp_path):
     (tmp_path / "half" / "radiance.zarr").mkdir()
     with pytest.raises(CollectionError, match="corrupted"):
         Collection.open(tmp_path / "half")
+
+
+def test_photometry_and_illuminance_sweep(smoke_collection):
+    c = Collection.open(smoke_collection)
+    assert c.condition_names == ["day", "night", "day@1lux", "day@100lux"]
+    scene = c.scenes()[0].scene_id
+    day, night = c.photometry(scene, "day"), c.photometry(scene, "night")
+    # Daylight is tens of kilolux at the camera; night is below one lux.
+    assert day["illuminance_at_camera_lux"] > 1e4 and night["illuminance_at_camera_lux"] < 1.0
+    assert day["image_plane_illuminance_lux"] > 10.0
+    for level in (1.0, 100.0):
+        p = c.photometry(scene, f"day@{level:g}lux")
+        assert p["illuminance_at_camera_lux"] == pytest.approx(level, rel=1e-9)
+        # Scaling the only light group scales the luminance by the same factor.
+        assert p["mean_luminance_cd_m2"] == pytest.approx(
+            day["mean_luminance_cd_m2"] * level / day["illuminance_at_camera_lux"], rel=1e-4)
+    # E = pi L / (1 + 4 N^2) for an ideal f/2.4 lens.
+    assert day["image_plane_illuminance_lux"] == pytest.approx(np.pi * day["mean_luminance_cd_m2"] / (1 + 4 * 2.4**2))

@@ -1,0 +1,101 @@
+"""The camera pipeline: a spectral scene through optics, sensor, exposure and ISP.
+
+``simulate(scene, camera, seed=...)`` is what ``benchmark run`` calls for every scene:
+
+    radiance (resampled to the pixel grid) ──optics──▶ electron-rate per channel
+    ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from benchmark import exposure as _exposure
+from benchmark import isp as _isp
+from benchmark import optics as _optics
+from benchmark import sensor as _sensor
+from benchmark.cameras.spec import CameraSpec
+from metricscenes.geometry import TanExtent
+from metricscenes.radiance import SpectralScene
+
+
+@dataclass(frozen=True)
+class Capture:
+    """One simulated image.
+
+    Attributes:
+        rgb8: (height, width, 3) uint8 sRGB.
+        raw_dn: (height, width) uint16 Bayer RGGB mosaic, black level included.
+        exposure_s: integration time, s.
+        camera_name: the camera's registry name.
+        width_px, height_px: image size.
+        seed: the temporal-noise seed.
+        camera_sha256: hash of the resolved camera spec.
+        electrons: (height, width) float32 noise-free signal electrons of the mosaic.
+        rgb_linear: (height, width, 3) float32 linear sRGB when ``isp.output`` is
+            ``linear``, else None.
+    """
+
+    rgb8: np.ndarray
+    raw_dn: np.ndarray
+    exposure_s: float
+    camera_name: str
+    width_px: int
+    height_px: int
+    seed: int
+    camera_sha256: str
+    electrons: np.ndarray
+    rgb_linear: np.ndarray | None = None
+
+
+def electron_rate(
+    scene: SpectralScene,
+    camera: CameraSpec,
+    *,
+    shape_px: tuple[int, int] | None = None,
+    extent: TanExtent | None = None,
+    diffraction: bool = True,
+) -> np.ndarray:
+    """Noise-free signal, electrons·s⁻¹, per channel (3, rows, cols).
+
+    ``shape_px`` (rows, cols) and ``extent`` select a window of the sensor (default:
+    the full frame); the window must be sampled at the camera's pixel pitch.
+    """
+    rows, cols = shape_px or (camera.height_px, camera.width_px)
+    radiance = scene.resample(cols, rows, extent)
+    if not np.all(np.isfinite(radiance)):
+        raise ValueError("scene radiance contains NaN or infinite values")
+    resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))
+    return _optics.channel_signal(
+        radiance, scene.wavelengths_nm, camera.optics, camera.pixel_um, resp, diffraction=diffraction
+    )
+
+
+def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool = True) -> Capture:
+    """Simulate one capture of ``scene`` by ``camera``.
+
+    Args:
+        scene: spectral radiance, W·sr⁻¹·m⁻²·nm⁻¹, covering the reference field of view.
+        camera: the camera spec.
+        seed: temporal-noise seed (``np.random.default_rng(seed)``): same seed, same raw.
+        noise: False switches every noise source off (shot, read, dark, PRNU, DSNU).
+    """
+    rate = _sensor.mosaic(electron_rate(scene, camera), camera.sensor.cfa)
+    exposure_s = _exposure.exposure_time_s(rate, camera.sensor, camera.exposure)
+    opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
+    raw = _sensor.capture_dn(rate, exposure_s, camera.sensor, np.random.default_rng(seed), opts)
+    rgb_linear = _isp.process(raw, camera.sensor, camera.isp)
+    return Capture(
+        rgb8=_isp.encode_srgb8(rgb_linear),
+        raw_dn=raw,
+        exposure_s=exposure_s,
+        camera_name=camera.name,
+        width_px=camera.width_px,
+        height_px=camera.height_px,
+        seed=int(seed),
+        camera_sha256=camera.sha256(),
+        electrons=(rate * np.float32(exposure_s)).astype(np.float32),
+        rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
+    )

@@ -1,0 +1,94 @@
+"""The camera registry: the paper's 13 cameras (``cam01`` ... ``cam13``) as packaged
+YAML files, plus user specs loaded from any YAML path.
+
+Errors are one-line :class:`ValueError` s naming the field and its allowed range, so a
+CLI can print them as they are.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+from benchmark.cameras.spec import CameraSpec
+
+DATA_DIR = Path(__file__).parent / "data"
+
+
+def camera_names() -> list[str]:
+    """Names of the packaged cameras, in the paper's order."""
+    return sorted(p.stem for p in DATA_DIR.glob("cam*.yaml"))
+
+
+def list_cameras() -> list[CameraSpec]:
+    """The packaged cameras, in the paper's order."""
+    return [load_camera(name) for name in camera_names()]
+
+
+def load_camera(name_or_path: str | int | Path) -> CameraSpec:
+    """A camera by registry name (``"cam12"``), number (``12`` or ``"12"``) or YAML path.
+
+    Raises:
+        ValueError: unknown name (the message lists the valid ones), unreadable YAML,
+            or a field out of range (the message names the field and its range).
+    """
+    text = str(name_or_path).strip()
+    path = Path(text)
+    if text.isdigit():
+        text = f"cam{int(text):02d}"
+    if text in camera_names():
+        path = DATA_DIR / f"{text}.yaml"
+    elif not (path.suffix.lower() in (".yaml", ".yml", ".json") or path.is_file()):
+        raise ValueError(f"unknown camera {name_or_path!r}; valid names: {', '.join(camera_names())}")
+    if not path.is_file():
+        raise ValueError(f"camera file not found: {path}")
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise ValueError(f"{path}: invalid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    return camera_from_dict(data, source=str(path))
+
+
+def camera_from_dict(data: Any, source: str = "camera spec") -> CameraSpec:
+    """Validate a mapping into a :class:`CameraSpec` (one-line ValueError on failure)."""
+    if not isinstance(data, dict):
+        raise ValueError(f"{source}: expected a mapping of camera fields, got {type(data).__name__}")
+    try:
+        return CameraSpec.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = ".".join(str(p) for p in err["loc"])
+        allowed = _allowed(CameraSpec, err["loc"])
+        value = f" = {err['input']!r}" if err["type"] != "missing" else ""
+        raise ValueError(f"{source}: field '{loc}'{value}: {err['msg']}{allowed}") from None
+
+
+def _allowed(model: type[BaseModel], loc: tuple) -> str:
+    """``' (allowed: 0.2 <= pixel_um <= 20)'`` from the field's constraints, if any."""
+    for i, key in enumerate(loc):
+        field = model.model_fields.get(str(key))
+        if field is None:
+            return ""
+        ann = field.annotation
+        if isinstance(ann, type) and issubclass(ann, BaseModel) and i + 1 < len(loc):
+            model = ann
+            continue
+        lo = hi = None
+        for meta in field.metadata:
+            for attr, sym in (("ge", "<="), ("gt", "<")):
+                if getattr(meta, attr, None) is not None:
+                    lo = f"{getattr(meta, attr)} {sym} "
+            for attr, sym in (("le", "<="), ("lt", "<")):
+                if getattr(meta, attr, None) is not None:
+                    hi = f" {sym} {getattr(meta, attr)}"
+        if lo or hi:
+            return f" (allowed: {lo or ''}{key}{hi or ''})"
+        if getattr(ann, "__args__", None) and all(isinstance(a, str) for a in ann.__args__):
+            return f" (allowed: {', '.join(ann.__args__)})"
+        return ""
+    return ""

@@ -1,0 +1,153 @@
+"""The camera specification: optics, sensor, exposure policy and ISP options.
+
+A :class:`CameraSpec` is a frozen pydantic model; every field has a unit in its name
+and a validated range. The defaults describe the paper's camera (Liu et al., EI 2023):
+4.38 mm diffraction-limited lens over a 2.688 x 1.512 mm Sony IMX363-like sensor, with
+the figures of ISETCam's ``sensorIMX363`` (see ``docs/camera.md``). Only the pixel
+pitch and the f-number differ between the 13 registry cameras.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, computed_field
+
+from metricscenes.geometry import (
+    REFERENCE_ACTIVE_HEIGHT_MM,
+    REFERENCE_ACTIVE_WIDTH_MM,
+    REFERENCE_FOCAL_LENGTH_MM,
+)
+
+_STRICT = ConfigDict(extra="forbid", frozen=True)
+
+
+class OpticsSpec(BaseModel):
+    """Diffraction-limited lens (circular pupil, no aberrations)."""
+
+    model_config = _STRICT
+
+    focal_length_mm: float = Field(REFERENCE_FOCAL_LENGTH_MM, gt=0.5, le=100.0)
+    f_number: float = Field(..., ge=0.5, le=64.0)
+    transmittance: float = Field(1.0, gt=0.0, le=1.0)
+    cos4_falloff: bool = False
+
+
+class SensorSpec(BaseModel):
+    """Sensor geometry, spectral response and noise (IMX363-like defaults, ISETCam)."""
+
+    model_config = _STRICT
+
+    pixel_um: float = Field(..., ge=0.2, le=20.0)
+    active_width_mm: float = Field(REFERENCE_ACTIVE_WIDTH_MM, gt=0.0, le=50.0)
+    active_height_mm: float = Field(REFERENCE_ACTIVE_HEIGHT_MM, gt=0.0, le=50.0)
+    cfa: Literal["RGGB"] = "RGGB"
+    qe: str = Field("imx363_qe.csv", min_length=1)
+    """Packaged CSV name (``benchmark/cameras/data``) or a path; columns
+    ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``."""
+    fill_factor: float = Field(1.0, gt=0.0, le=1.0)
+    well_capacity_e: float = Field(6000.0, gt=0.0, le=1e7)
+    conversion_gain_uv_per_e: float = Field(76.5, gt=0.0, le=1e4)
+    voltage_swing_v: float = Field(0.4591, gt=0.0, le=10.0)
+    read_noise_e: float = Field(5.0, ge=0.0, le=1000.0)
+    dark_current_e_per_s: float = Field(0.0, ge=0.0, le=1e6)
+    dsnu_v: float = Field(0.0, ge=0.0, le=1.0)
+    prnu_fraction: float = Field(0.007, ge=0.0, le=0.5)
+    adc_bits: int = Field(10, ge=8, le=16)
+    black_level_dn: int = Field(64, ge=0, le=4096)
+    analog_gain: float = Field(1.0, gt=0.0, le=64.0)
+    """Multiplies the pixel voltage (ISO 55 = 1, as ISETCam's isoUnityGain)."""
+    fpn_seed: int = Field(0, ge=0)
+    """Seed of the fixed-pattern noise maps (PRNU, DSNU): a property of the sensor
+    unit, the same in every capture, independent of the capture seed."""
+
+    @computed_field
+    @property
+    def width_px(self) -> int:
+        return int(round(self.active_width_mm * 1000.0 / self.pixel_um))
+
+    @computed_field
+    @property
+    def height_px(self) -> int:
+        return int(round(self.active_height_mm * 1000.0 / self.pixel_um))
+
+    @property
+    def pixel_area_m2(self) -> float:
+        return (self.pixel_um * 1e-6) ** 2
+
+    @property
+    def lsb_v(self) -> float:
+        """Volts per DN: the swing spans the full ADC range (ISETCam)."""
+        return self.voltage_swing_v / (2**self.adc_bits - 1)
+
+    @property
+    def white_level_dn(self) -> int:
+        return 2**self.adc_bits - 1
+
+
+class ExposureSpec(BaseModel):
+    """Exposure policy. ``auto_peak``: the paper's (noise-free peak voltage in the
+    central region at ``level`` of the swing); ``mean_level``: the mean voltage of the
+    central region at ``level`` of the swing; ``fixed``: ``exposure_s``."""
+
+    model_config = _STRICT
+
+    mode: Literal["auto_peak", "fixed", "mean_level"] = "auto_peak"
+    level: float = Field(0.90, gt=0.0, le=1.0)
+    region_fraction: float = Field(0.5, gt=0.0, le=1.0)
+    """Side of the central region as a fraction of the frame's width and height."""
+    max_exposure_s: float = Field(0.016, gt=0.0, le=60.0)
+    exposure_s: float = Field(1.0 / 60.0, gt=0.0, le=60.0)
+
+
+class ISPSpec(BaseModel):
+    """Image processing: demosaic, white balance, colour matrix, output encoding."""
+
+    model_config = _STRICT
+
+    demosaic: Literal["malvar2004", "bilinear"] = "malvar2004"
+    white_balance: Literal["grey_world", "known_illuminant"] = "grey_world"
+    illuminant: str = "D65"
+    """Illuminant for ``known_illuminant`` white balance (a colour-science name)."""
+    output: Literal["srgb8", "linear"] = "srgb8"
+
+
+class CameraSpec(BaseModel):
+    """One camera of the benchmark."""
+
+    model_config = _STRICT
+
+    name: str = Field(..., pattern=r"^[A-Za-z0-9_.-]+$", max_length=64)
+    label: str = ""
+    mtf50_group_cy_per_mm: float | None = Field(None, gt=0.0, le=2000.0)
+    """The MTF50 group the paper published for this camera (None for user cameras)."""
+    optics: OpticsSpec
+    sensor: SensorSpec
+    exposure: ExposureSpec = ExposureSpec()
+    isp: ISPSpec = ISPSpec()
+
+    @property
+    def width_px(self) -> int:
+        return self.sensor.width_px
+
+    @property
+    def height_px(self) -> int:
+        return self.sensor.height_px
+
+    @property
+    def pixel_um(self) -> float:
+        return self.sensor.pixel_um
+
+    @property
+    def f_number(self) -> float:
+        return self.optics.f_number
+
+    def canonical_json(self) -> str:
+        """The resolved spec (defaults filled in) as sorted, compact JSON."""
+        return json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+
+    def sha256(self) -> str:
+        """sha256 (hex) of :meth:`canonical_json`: identifies the camera in results."""
+        return hashlib.sha256(self.canonical_json().encode("utf-8")).hexdigest()

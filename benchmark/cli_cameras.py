@@ -1,0 +1,144 @@
+"""``benchmark cameras``: list, show and measure (MTF50) the registry's cameras.
+
+Mounted by the main CLI as ``app.add_typer(cameras_app, name="cameras")``. Errors print
+one line and exit with code 2.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from benchmark.cameras import CameraSpec, list_cameras, load_camera
+
+app = typer.Typer(help="The camera registry: list, show, measure MTF50.", no_args_is_help=True)
+_out = Console()
+
+
+def _fail(message: str) -> None:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code=2)
+
+
+def _load(names: list[str]) -> list[CameraSpec]:
+    try:
+        return [load_camera(n) for n in names] if names else list_cameras()
+    except ValueError as exc:
+        _fail(str(exc))
+
+
+def _summary(cam: CameraSpec) -> dict:
+    return {
+        "name": cam.name,
+        "label": cam.label,
+        "pixel_um": cam.pixel_um,
+        "f_number": cam.f_number,
+        "width_px": cam.width_px,
+        "height_px": cam.height_px,
+        "mtf50_group": cam.mtf50_group_cy_per_mm,
+        "sha256": cam.sha256(),
+    }
+
+
+@app.command("list")
+def list_command(as_json: bool = typer.Option(False, "--json", help="Print JSON.")) -> None:
+    """List the registry's cameras."""
+    rows = [_summary(c) for c in _load([])]
+    if as_json:
+        print(json.dumps(rows, indent=2))
+        return
+    table = Table(title="Cameras (focal length 4.38 mm, active area 2.688 x 1.512 mm)")
+    for col in ("name", "pixel µm", "f-number", "size px", "MTF50 group c/mm", "sha256"):
+        table.add_column(col)
+    for r in rows:
+        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}",
+                      f"{r['width_px']}x{r['height_px']}", f"{r['mtf50_group'] or '-'}", r["sha256"][:12])
+    _out.print(table)
+
+
+@app.command("show")
+def show_command(
+    name: str = typer.Argument(..., help="cam01..cam13, a number, or a YAML path."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON."),
+) -> None:
+    """Show a camera's resolved spec (defaults filled in)."""
+    cam = _load([name])[0]
+    data = {**cam.model_dump(mode="json"), "sha256": cam.sha256()}
+    if as_json:
+        print(json.dumps(data, indent=2))
+        return
+    table = Table(title=f"{cam.name}: {cam.label}")
+    table.add_column("field")
+    table.add_column("value")
+    for section, values in data.items():
+        if isinstance(values, dict):
+            for key, value in values.items():
+                table.add_row(f"{section}.{key}", str(value))
+        else:
+            table.add_row(section, str(values))
+    _out.print(table)
+
+
+@app.command("mtf")
+def mtf_command(
+    names: Optional[list[str]] = typer.Argument(None, help="Cameras (default: all 13)."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the MTF curves to this image."),
+) -> None:
+    """Measure MTF50 (ISO 12233 e-SFR through optics + sensor + demosaic)."""
+    from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
+
+    cams = _load(names or [])
+    results, curves = [], []
+    for cam in cams:
+        try:
+            m = measure_mtf50(cam)
+        except ValueError as exc:
+            _fail(f"{cam.name}: {exc}")
+        curves.append((cam.name, m["freq_cy_per_mm"], m["mtf"]))
+        results.append({
+            "name": cam.name,
+            "pixel_um": cam.pixel_um,
+            "f_number": cam.f_number,
+            "mtf50_cy_per_mm": round(m["mtf50_cy_per_mm"], 2),
+            "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(cam.pixel_um, cam.f_number), 2),
+            "mtf50_group": cam.mtf50_group_cy_per_mm,
+            "nyquist_cy_per_mm": round(500.0 / cam.pixel_um, 2),
+        })
+    if plot is not None:
+        _plot(curves, plot)
+    if as_json:
+        print(json.dumps(results, indent=2))
+        return
+    table = Table(title="MTF50 (cycles/mm on the sensor); analytic = diffraction x pixel, polychromatic")
+    for col in ("name", "pixel µm", "f-number", "measured", "analytic", "paper group", "Nyquist"):
+        table.add_column(col, justify="right")
+    for r in results:
+        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['mtf50_cy_per_mm']:.1f}",
+                      f"{r['mtf50_analytic_cy_per_mm']:.1f}", f"{r['mtf50_group'] or '-'}", f"{r['nyquist_cy_per_mm']:.0f}")
+    _out.print(table)
+
+
+def _plot(curves: list, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for name, freq, mtf in curves:
+        ax.plot(freq, mtf, label=name)
+    ax.axhline(0.5, color="grey", lw=0.8, ls="--")
+    ax.set(xlabel="cycles/mm on the sensor", ylabel="MTF (luminance)", xlim=(0, 500), ylim=(0, 1.1))
+    ax.legend(ncol=2, fontsize=8)
+    try:
+        fig.savefig(path, dpi=120, bbox_inches="tight")
+    except (OSError, ValueError) as exc:
+        _fail(f"cannot write plot {path}: {exc}")
+    finally:
+        plt.close(fig)

@@ -1,0 +1,109 @@
+"""``benchmark submit``, ``benchmark leaderboard`` and ``benchmark schema``.
+
+Mounted by ``benchmark/cli.py`` through :func:`register`. Every refusal is one line on
+stderr and exit code 2; ``--check`` and refused submissions never touch the leaderboard.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from benchmark.leaderboard.schema import SubmissionError
+
+
+def _fail(message: str, code: int = 2) -> None:
+    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
+    raise typer.Exit(code)
+
+
+def submit(
+    results_dir: Annotated[Optional[Path], typer.Argument(help="a run folder (results.json) or a sweep folder (runs/*/results.json)")] = None,
+    name: Annotated[Optional[str], typer.Option(help="system name = file name; put {camera} in it to submit every camera of a sweep")] = None,
+    submitter: Annotated[str, typer.Option(help="who submits (name, team, contact)")] = "anonymous",
+    camera: Annotated[Optional[str], typer.Option(help="submit only this camera of a sweep")] = None,
+    leaderboard: Annotated[Path, typer.Option("--leaderboard", help="leaderboard folder")] = Path("leaderboard"),
+    check: Annotated[Optional[Path], typer.Option("--check", help="validate this submission file instead of building one")] = None,
+    detections: Annotated[Optional[list[Path]], typer.Option(help="with --check: a detections file to recompute AP from (repeatable, matched to a condition by sha256)")] = None,
+    groundtruth: Annotated[Optional[Path], typer.Option(help="with --detections: the ground truth on the camera grid (a run's groundtruth.json)")] = None,
+    n_resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples for OD50's SD")] = 1000,
+    created_at: Annotated[Optional[str], typer.Option(help="fix the timestamp (YYYY-MM-DDTHH:MM:SSZ); default now, or SOURCE_DATE_EPOCH")] = None,
+    mtf: Annotated[bool, typer.Option(help="measure MTF50 on the camera (else the published group)")] = True,
+) -> None:
+    """Build a leaderboard submission from a run or sweep folder, or --check one."""
+    from benchmark.leaderboard import (
+        build_submission, check_not_duplicate, check_submission_file, find_runs, group_by_camera, load_protocols,
+        write_submission,
+    )  # fmt: skip
+
+    try:
+        if check is not None:
+            if results_dir is not None or name is not None:
+                _fail("--check FILE takes no RESULTS_DIR or --name")
+            lb = leaderboard if leaderboard.is_dir() else None
+            data = check_submission_file(check, leaderboard_dir=lb, detections=detections or [], groundtruth=groundtruth)
+            conditions = ", ".join(sorted(data["conditions"]))
+            recomputed = f"; AP recomputed from {len(detections)} detections file(s)" if detections else ""
+            typer.echo(f"ok: {check.name} (protocol {data['collection']['protocol']}, conditions {conditions}{recomputed})")
+            return
+        if results_dir is None or name is None:
+            _fail("give RESULTS_DIR and --name (or --check FILE)")
+        if detections or groundtruth:
+            _fail("--detections/--groundtruth go with --check; a run folder's own detections.json is always verified")
+        groups = group_by_camera(find_runs(results_dir))
+        if camera is not None:
+            if camera not in groups:
+                _fail(f"camera {camera!r} is not in {results_dir} (cameras: {', '.join(groups)})")
+            groups = {camera: groups[camera]}
+        if len(groups) > 1 and "{camera}" not in name:
+            _fail(f"{results_dir} holds {len(groups)} cameras ({', '.join(groups)}): put {{camera}} in --name or choose one with --camera")
+        protocols = load_protocols(leaderboard)
+        subs = [build_submission(runs, name=name.replace("{camera}", cam), submitter=submitter, created_at=created_at,
+                                 n_resamples=n_resamples, measure_mtf=mtf, protocols=protocols)
+                for cam, runs in groups.items()]  # fmt: skip
+        for sub in subs:  # all checked before any is written
+            check_not_duplicate(sub, leaderboard)
+        for sub in subs:
+            path = write_submission(sub, leaderboard)
+            day = sub["conditions"]["day"]["od50_m"]
+            skipped = sorted({r.condition for r in groups[sub["camera"]["name"]]} - set(sub["conditions"]))
+            note = f"; not ranked, left out: {', '.join(skipped)}" if skipped else ""
+            typer.echo(f"wrote {path} (day OD50 {'inf' if day is None else f'{day:.1f} m'}; conditions {', '.join(sorted(sub['conditions']))}{note})")
+    except (SubmissionError, ValueError) as exc:
+        _fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+
+
+def leaderboard_cmd(
+    dir: Annotated[Path, typer.Option("--dir", help="leaderboard folder (holds submissions/)")] = Path("leaderboard"),
+) -> None:
+    """Render README.md and index.html from the leaderboard's submissions/."""
+    from benchmark.leaderboard import render_leaderboard
+
+    if not dir.is_dir():
+        _fail(f"{dir}: no such leaderboard folder")
+    try:
+        readme, page = render_leaderboard(dir)
+    except (SubmissionError, ValueError) as exc:
+        _fail(f"{str(exc).splitlines()[0]} (the table was not changed)")
+    typer.echo(f"wrote {readme} and {page}")
+
+
+SCHEMAS = ("submission",)
+
+
+def schema(which: Annotated[str, typer.Argument(help="which schema: submission")] = "submission") -> None:
+    """Print a JSON Schema shipped with the package."""
+    from benchmark.leaderboard import schema_text
+
+    if which not in SCHEMAS:
+        _fail(f"unknown schema {which!r} (known: {', '.join(SCHEMAS)})")
+    typer.echo(schema_text(), nl=False)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``submit``, ``leaderboard`` and ``schema`` to the ``benchmark`` app."""
+    app.command("submit")(submit)
+    app.command("leaderboard")(leaderboard_cmd)
+    app.command("schema")(schema)

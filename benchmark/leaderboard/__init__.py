@@ -1,0 +1,64 @@
+"""The leaderboard: submission format (JSON Schema), building, validation, rendering.
+
+>>> runs = find_runs("sweeps/quick")                                          # doctest: +SKIP
+>>> sub = build_submission(group_by_camera(runs)["cam12"], name="cam12-yolov5n", submitter="me")  # doctest: +SKIP
+>>> write_submission(sub, "leaderboard"); render_leaderboard("leaderboard")   # doctest: +SKIP
+
+See docs/leaderboard.md for the format and the rules.
+"""
+
+from benchmark.leaderboard.files import atomic_write_bytes, atomic_write_text, tree_sha256
+from benchmark.leaderboard.protocols import Protocol, load_protocols
+from benchmark.leaderboard.render import load_submissions, rank_key, render_html, render_leaderboard, render_markdown
+from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError, check_schema, loads_strict, schema_text, submission_schema
+from benchmark.leaderboard.submission import (
+    Run,
+    build_submission,
+    created_at_now,
+    dumps_submission,
+    find_runs,
+    group_by_camera,
+    write_submission,
+)
+from benchmark.leaderboard.validate import (
+    MAX_SUBMISSION_BYTES,
+    check_name,
+    check_not_duplicate,
+    check_submission_file,
+    read_submission_file,
+    validate_submission,
+    verify_detections,
+)
+
+__all__ = [
+    "MAX_SUBMISSION_BYTES",
+    "SUBMISSION_FORMAT",
+    "Protocol",
+    "Run",
+    "SubmissionError",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "build_submission",
+    "check_name",
+    "check_not_duplicate",
+    "check_schema",
+    "check_submission_file",
+    "created_at_now",
+    "dumps_submission",
+    "find_runs",
+    "group_by_camera",
+    "load_protocols",
+    "load_submissions",
+    "loads_strict",
+    "rank_key",
+    "read_submission_file",
+    "render_html",
+    "render_leaderboard",
+    "render_markdown",
+    "schema_text",
+    "submission_schema",
+    "tree_sha256",
+    "validate_submission",
+    "verify_detections",
+    "write_submission",
+]

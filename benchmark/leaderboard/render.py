@@ -1,0 +1,218 @@
+"""Render the leaderboard (``README.md`` and ``index.html``) from ``submissions/*.json``.
+
+Deterministic: the output depends only on the submissions (and the accepted protocols):
+rows are ranked by daylight OD50, then night OD50 (missing = last), then name; the only
+date shown is the newest submission's ``created_at``. Both files are written atomically
+(:func:`benchmark.leaderboard.files.atomic_write_text`) and only after every submission
+has validated, so a bad submission or an interrupted render leaves the old table intact.
+
+The HTML page is self-contained: inline CSS and a small vanilla-JS sorter, allowed by a
+Content-Security-Policy that names their sha256 and nothing else (no external URLs).
+Clicking a column header sets ``#sort=<key>`` (``#sort=-<key>``: descending) and the
+tables sort on ``hashchange``, so a sorted view is a link (and testable headlessly).
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import html
+import math
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from benchmark.leaderboard.files import atomic_write_text
+from benchmark.leaderboard.protocols import Protocol, load_protocols
+from benchmark.leaderboard.validate import SUBMISSIONS, read_submission_file, validate_submission
+
+REPRODUCE = """\
+metricscenes generate --manifest manifests/quick.yaml --out collections/quick
+benchmark sweep --collection collections/quick --model yolov5n-dynamic --out sweeps/quick
+benchmark submit sweeps/quick --name 'ref-{camera}-yolov5n-quick' --submitter 'metricscenes reference'
+benchmark leaderboard"""
+
+
+@dataclass(frozen=True)
+class Column:
+    key: str
+    header: str
+    kind: str  # "num" | "str": how the page sorts it
+
+
+def load_submissions(leaderboard_dir: str | Path, protocols: dict[str, Protocol] | None = None) -> list[dict]:
+    """Every ``submissions/*.json``, validated (first failure raises :class:`SubmissionError`), by name."""
+    folder = Path(leaderboard_dir) / SUBMISSIONS
+    protocols = load_protocols(leaderboard_dir) if protocols is None else protocols
+    out = []
+    for path in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+        out.append(validate_submission(read_submission_file(path), protocols=protocols, source=f"{SUBMISSIONS}/{path.name}"))
+    return out
+
+
+def _od50(sub: dict, condition: str) -> float | None:
+    """OD50 in metres: +inf where the submission says null (AP does not fall to 0.5), None if absent."""
+    cond = sub["conditions"].get(condition)
+    if cond is None:
+        return None
+    return math.inf if cond["od50_m"] is None else float(cond["od50_m"])
+
+
+def rank_key(sub: dict) -> tuple:
+    """Sort key: daylight OD50 descending, then night OD50 descending (absent last), then name."""
+    day = _od50(sub, "day")
+    night = _od50(sub, "night")
+    return (-(day if day is not None else -math.inf), -(night if night is not None else -math.inf), sub["name"])
+
+
+def ranked(submissions: list[dict]) -> list[dict]:
+    return sorted(submissions, key=rank_key)
+
+
+def _fmt_od50(cond: dict | None) -> tuple[str, str]:
+    """(sort value, text) of one condition's OD50 ± SD."""
+    if cond is None:
+        return "", "–"
+    if cond["od50_m"] is None:
+        return "Infinity", "∞"
+    sd = cond["od50_sd_m"]
+    text = f"{cond['od50_m']:.1f}" + (f" ± {sd:.1f}" if sd is not None else "")
+    return repr(float(cond["od50_m"])), text
+
+
+def _num(value, fmt: str) -> tuple[str, str]:
+    return ("", "–") if value is None else (repr(float(value)), format(value, fmt))
+
+
+def columns(protocol: Protocol) -> list[Column]:
+    od50 = [Column(f"{c}_od50", f"{c.capitalize()} OD50 (m)", "num") for c in protocol.conditions]
+    return [Column("rank", "#", "num"), Column("system", "System", "str"), Column("camera", "Camera", "str"), *od50,
+            Column("mtf50", "MTF50 (cy/mm)", "num"), Column("pixel_um", "Pixel (µm)", "num"),
+            Column("f_number", "f-number", "num"), Column("detector", "Detector", "str"),
+            Column("submitter", "Submitter", "str"), Column("date", "Date", "str")]  # fmt: skip
+
+
+def row_cells(rank: int, sub: dict, protocol: Protocol) -> dict[str, tuple[str, str]]:
+    """``{column key: (sort value, text)}`` of one submission."""
+    spec = sub["camera"]["spec"]
+    mtf = sub["camera"]["mtf50_cy_per_mm"]
+    cells = {"rank": (str(rank), str(rank)), "system": (sub["name"], sub["name"]), "camera": (sub["camera"]["name"],) * 2}
+    for c in protocol.conditions:
+        cells[f"{c}_od50"] = _fmt_od50(sub["conditions"].get(c))
+    mtf_sort, mtf_text = _num(mtf, ".0f")
+    if sub["camera"]["mtf50_source"] == "published_group":
+        mtf_text += " (group)"
+    cells.update({
+        "mtf50": (mtf_sort, mtf_text),
+        "pixel_um": _num(spec["sensor"]["pixel_um"], "g"),
+        "f_number": _num(spec["optics"]["f_number"], "g"),
+        "detector": (sub["detector"]["name"],) * 2,
+        "submitter": (sub["submitter"],) * 2,
+        "date": (sub["created_at"], sub["created_at"][:10]),
+    })  # fmt: skip
+    return cells
+
+
+def _by_protocol(submissions: list[dict], protocols: dict[str, Protocol]) -> list[tuple[Protocol, list[dict]]]:
+    return [(p, ranked([s for s in submissions if s["collection"]["protocol"] == name])) for name, p in protocols.items()]
+
+
+def _md(text: str) -> str:
+    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+
+
+def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
+    latest = max((s["created_at"] for s in submissions), default=None)
+    lines = [
+        "# metricscenes leaderboard", "",
+        "<!-- Generated by `benchmark leaderboard` from submissions/; edits are overwritten. -->", "",
+        "How far away does a camera system (camera + ISP + detector) still find a car? Each table ranks",
+        "systems by **daylight OD50**, the distance at which COCO AP of the car falls to 0.5 (Liu et al.,",
+        "EI 2023), then by night OD50. ± is the bootstrap SD over environments; ∞: AP does not fall to 0.5",
+        "within (or extrapolated beyond) the protocol's distances. MTF50 is measured on the camera's",
+        "simulated slanted edge (ISO 12233), or the paper's published group where marked. Open",
+        "[index.html](index.html) for a sortable table; see [docs/leaderboard.md](../docs/leaderboard.md)",
+        "for the submission format and rules.", "",
+        f"{len(submissions)} submission(s)" + (f"; newest {latest}." if latest else "."), "",
+    ]  # fmt: skip
+    for protocol, subs in _by_protocol(submissions, protocols):
+        cols = columns(protocol)
+        lines += [f"## {protocol.name}", "", f"{protocol.description}.", ""]
+        if not subs:
+            lines += ["No submissions yet.", ""]
+            continue
+        lines.append("| " + " | ".join(c.header for c in cols) + " |")
+        lines.append("|" + "|".join("---:" if c.kind == "num" else "---" for c in cols) + "|")
+        for rank, sub in enumerate(subs, 1):
+            cells = row_cells(rank, sub, protocol)
+            cells["system"] = ("", f"[{_md(sub['name'])}](submissions/{sub['name']}.json)")
+            lines.append("| " + " | ".join(_md(cells[c.key][1]) if c.key != "system" else cells[c.key][1] for c in cols) + " |")
+        lines.append("")
+    lines += [
+        "## Reproduce the reference submissions", "",
+        "The 13 paper cameras with YOLOv5n on the quick collection (all conditions):", "",
+        "```sh", REPRODUCE, "```", "",
+        "## Submit", "",
+        "```sh",
+        "benchmark submit RUN_OR_SWEEP_FOLDER --name NAME --submitter 'WHO'   # writes leaderboard/submissions/NAME.json",
+        "benchmark submit --check leaderboard/submissions/NAME.json            # what the maintainers run",
+        "benchmark leaderboard                                                 # re-renders this file and index.html",
+        "```", "",
+    ]  # fmt: skip
+    return "\n".join(lines)
+
+
+def _asset(name: str) -> str:
+    return resources.files("benchmark.leaderboard").joinpath("data", name).read_text(encoding="utf-8")
+
+
+def _csp_hash(text: str) -> str:
+    return "'sha256-" + base64.b64encode(hashlib.sha256(text.encode("utf-8")).digest()).decode() + "'"
+
+
+def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
+    esc = html.escape
+    style, script = _asset("leaderboard.css"), _asset("leaderboard.js")
+    csp = f"default-src 'none'; style-src {_csp_hash(style)}; script-src {_csp_hash(script)}; base-uri 'none'; form-action 'none'"
+    latest = max((s["created_at"] for s in submissions), default=None)
+    out = [
+        "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
+        f'<meta http-equiv="Content-Security-Policy" content="{esc(csp)}">',
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
+        "<title>metricscenes leaderboard</title>", f"<style>{style}</style>", "</head>", "<body>",
+        "<h1>metricscenes leaderboard</h1>",
+        "<p>Ranked by daylight OD50 (distance at which COCO AP of the car falls to 0.5), then night OD50. "
+        "± is the bootstrap SD over environments; ∞: AP does not fall to 0.5. Click a column to sort.</p>",
+        f'<p class="meta">{len(submissions)} submission(s)' + (f"; newest {esc(latest)}" if latest else "") + ".</p>",
+    ]  # fmt: skip
+    for protocol, subs in _by_protocol(submissions, protocols):
+        cols = columns(protocol)
+        out += [f'<section id="protocol-{esc(protocol.name)}">', f"<h2>{esc(protocol.name)}</h2>", f"<p>{esc(protocol.description)}.</p>"]
+        if not subs:
+            out += ['<p class="empty">No submissions yet.</p>', "</section>"]
+            continue
+        out.append(f'<table class="sortable" data-protocol="{esc(protocol.name)}">')
+        out.append("<thead><tr>" + "".join(
+            f'<th data-key="{c.key}" data-type="{c.kind}" aria-sort="{"ascending" if c.key == "rank" else "none"}">'
+            f'<button type="button">{esc(c.header)}</button></th>' for c in cols) + "</tr></thead>")  # fmt: skip
+        out.append("<tbody>")
+        for rank, sub in enumerate(subs, 1):
+            cells = row_cells(rank, sub, protocol)
+            tds = []
+            for c in cols:
+                value, text = cells[c.key]
+                body = f'<a href="submissions/{esc(sub["name"])}.json">{esc(text)}</a>' if c.key == "system" else esc(text)
+                tds.append(f'<td data-v="{esc(value)}">{body}</td>')
+            out.append(f'<tr data-name="{esc(sub["name"])}">' + "".join(tds) + "</tr>")
+        out += ["</tbody>", "</table>", "</section>"]
+    out += [f"<script>{script}</script>", "</body>", "</html>", ""]
+    return "\n".join(out)
+
+
+def render_leaderboard(leaderboard_dir: str | Path = "leaderboard") -> tuple[Path, Path]:
+    """Validate every submission, then write ``README.md`` and ``index.html`` atomically; returns their paths."""
+    leaderboard_dir = Path(leaderboard_dir)
+    protocols = load_protocols(leaderboard_dir)
+    submissions = load_submissions(leaderboard_dir, protocols)
+    readme, page = render_markdown(submissions, protocols), render_html(submissions, protocols)
+    return atomic_write_text(leaderboard_dir / "README.md", readme), atomic_write_text(leaderboard_dir / "index.html", page)

@@ -1,0 +1,243 @@
+"""Build a submission from a run folder or a sweep folder (``benchmark submit``).
+
+A run folder (``benchmark run``) holds ``results.json``, ``detections.json`` and
+``groundtruth.json``; a sweep folder holds run folders under ``runs/``. One submission is
+one camera system: every run of one camera (one run per condition), with the same
+camera spec, detector, collection and scoring backend. Before anything is written each
+run's detections file is checked against its recorded sha256, AP is recomputed from it,
+and OD50's bootstrap SD over environments is computed (:func:`benchmark.scoring.bootstrap_od50`)
+unless the run already carries it with the same resampling settings.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import warnings
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+from benchmark.leaderboard.files import atomic_write_text, sha256_file
+from benchmark.leaderboard.protocols import load_protocols
+from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
+from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
+
+RESULTS_FORMAT = "metricscenes-results/1"
+N_RESAMPLES = 1000
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run folder and its parsed ``results.json``."""
+
+    folder: Path
+    results: dict
+
+    @property
+    def camera(self) -> str:
+        return self.results["camera"]["name"]
+
+    @property
+    def condition(self) -> str:
+        return self.results["condition"]
+
+
+def find_runs(results_dir: str | Path) -> list[Run]:
+    """The run folder ``results_dir``, or every ``results_dir/runs/*/`` of a sweep (sorted)."""
+    root = Path(results_dir)
+    if (root / "results.json").is_file():
+        folders = [root]
+    else:
+        folders = sorted(p.parent for p in root.glob("runs/*/results.json"))
+    if not folders:
+        raise SubmissionError(f"{root}: neither a run folder (results.json) nor a sweep (runs/*/results.json)")
+    runs = []
+    for folder in folders:
+        try:
+            results = json.loads((folder / "results.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise SubmissionError(f"{folder / 'results.json'}: cannot read ({type(exc).__name__})") from None
+        if not isinstance(results, dict) or results.get("format") != RESULTS_FORMAT:
+            raise SubmissionError(f"{folder / 'results.json'}: not a {RESULTS_FORMAT} file")
+        runs.append(Run(folder, results))
+    return runs
+
+
+def group_by_camera(runs: list[Run]) -> dict[str, list[Run]]:
+    """Runs by camera name, each group sorted by condition; a camera+condition twice is refused."""
+    groups: dict[str, list[Run]] = {}
+    for run in runs:
+        groups.setdefault(run.camera, []).append(run)
+    for camera, group in groups.items():
+        group.sort(key=lambda r: r.condition)
+        conditions = [r.condition for r in group]
+        for c in conditions:
+            if conditions.count(c) > 1:
+                raise SubmissionError(f"camera {camera!r} has {conditions.count(c)} runs under condition {c!r}; keep one")
+    return dict(sorted(groups.items()))
+
+
+def created_at_now() -> str:
+    """ISO 8601 UTC, seconds; ``SOURCE_DATE_EPOCH`` (reproducible-builds.org) fixes it."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    now = datetime.fromtimestamp(int(epoch), timezone.utc) if epoch else datetime.now(timezone.utc)
+    return now.strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def _none_if_not_finite(x: float) -> float | None:
+    return round(float(x), 3) if math.isfinite(x) else None
+
+
+def _detector_licence(detector: dict) -> str:
+    from benchmark.detectors import registry
+
+    for entry in registry().values():
+        if entry.sha256 == detector.get("sha256") or entry.name == detector.get("name"):
+            return entry.licence
+    return "unknown"
+
+
+def _mtf50(spec) -> tuple[float | None, str]:
+    """Measured MTF50 (ISO 12233 slanted edge through the camera); the published group if that fails."""
+    from benchmark.mtf import measure_mtf50
+
+    try:
+        return round(float(measure_mtf50(spec)["mtf50_cy_per_mm"]), 1), "measured"
+    except Exception:  # noqa: BLE001 -- a camera the MTF bench cannot image still gets a row
+        if spec.mtf50_group_cy_per_mm is not None:
+            return spec.mtf50_group_cy_per_mm, "published_group"
+        return None, "none"
+
+
+def _float(value) -> float:
+    """A JSON number, None (NaN) or "inf"/"-inf" (as the sweep's ``od50.json`` writes them) as a float."""
+    return float("nan") if value is None else float(value)
+
+
+def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> dict | None:
+    """The bootstrap a sweep stored in ``<run>/od50.json`` (:func:`benchmark.sweep.run_od50`), if it is for these settings."""
+    try:
+        stored = json.loads((folder / "od50.json").read_text(encoding="utf-8"))
+        if stored["key"] != {"detections_sha256": detections_sha256, "n_resamples": n_resamples, "seed": seed}:
+            return None
+        boot = stored["od50"]
+        return {"sd_m": _float(boot["sd_m"]), "ci95_m": [_float(v) for v in boot["ci95_m"]]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) -> dict:
+    """One condition of a submission from a run folder: verified AP, OD50, bootstrap SD."""
+    from benchmark.scoring import bootstrap_od50, od50
+
+    res = run.results
+    det_path = run.folder / res.get("detections_file", "detections.json")
+    gt_path = run.folder / "groundtruth.json"
+    for p in (det_path, gt_path):
+        if not p.is_file():
+            raise SubmissionError(f"{run.folder}: {p.name} is missing (needed to verify AP and bootstrap OD50)")
+    if sha256_file(det_path) != res["detections_sha256"]:
+        raise SubmissionError(f"{det_path}: sha256 differs from results.json's detections_sha256 (file changed?)")
+    entry = {
+        "per_distance": [
+            {"distance_m": float(r["distance_m"]), "ap": float(r["ap"]), "ap50": float(r["ap50"]), "n_images": int(r["n_images"])}
+            for r in sorted(res["per_distance"], key=lambda r: r["distance_m"])
+        ],
+        "od50_m": None,  # recomputed below from the AP curve, as the validator does
+        "seed": int(res.get("seed", 0)),
+        "detections_sha256": res["detections_sha256"],
+    }
+    entry["od50_m"] = _none_if_not_finite(od50([r["distance_m"] for r in entry["per_distance"]], [r["ap"] for r in entry["per_distance"]]))
+    probe = {"collection": res["collection"], "scoring": {"backend": res.get("scoring_backend", "faster-coco-eval")},
+             "conditions": {run.condition: entry}}
+    verify_detections(probe, [det_path], gt_path, source=str(run.folder / "results.json"))
+    gt = json.loads(gt_path.read_text(encoding="utf-8"))
+    boot = _cached_bootstrap(run.folder, res["detections_sha256"], n_resamples, seed)
+    if boot is None:
+        dets = json.loads(det_path.read_text(encoding="utf-8"))
+        with warnings.catch_warnings():  # percentiles of a distribution holding +inf OD50s warn; the CI ends become null
+            warnings.simplefilter("ignore", RuntimeWarning)
+            boot = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=probe["scoring"]["backend"])
+    lo, hi = (_float(v) for v in boot["ci95_m"])
+    entry.update({
+        "od50_sd_m": _none_if_not_finite(_float(boot["sd_m"])),
+        "od50_ci95_m": [_none_if_not_finite(lo), _none_if_not_finite(hi)],
+        "n_environments": len({im["environment_id"] for im in gt["images"]}),
+    })  # fmt: skip
+    return dict(sorted(entry.items()))
+
+
+def build_submission(
+    runs: list[Run],
+    *,
+    name: str,
+    submitter: str,
+    created_at: str | None = None,
+    n_resamples: int = N_RESAMPLES,
+    seed: int = 0,
+    measure_mtf: bool = True,
+    notes: str | None = None,
+    protocols: dict | None = None,
+) -> dict:
+    """A submission of one camera system from its runs (one per condition); validated before it is returned."""
+    from metricscenes import __version__
+
+    check_name(name)
+    protocols = load_protocols() if protocols is None else protocols
+    if runs and runs[0].results["collection"]["protocol"] in protocols:  # e.g. day@100lux runs of a sweep are not ranked
+        runs = [r for r in runs if r.condition in protocols[runs[0].results["collection"]["protocol"]].conditions]
+    if not runs:
+        raise SubmissionError("no runs to submit (none under a condition the protocol ranks)")
+    first = runs[0].results
+    for run in runs[1:]:
+        r = run.results
+        for label, key in (("camera spec", lambda x: x["camera"]["spec_sha256"]),
+                           ("detector", lambda x: (x["detector"]["sha256"], x["detector"]["input_size"])),
+                           ("collection", lambda x: x["collection"]["manifest_sha256"]),
+                           ("scoring backend", lambda x: x.get("scoring_backend"))):  # fmt: skip
+            if key(r) != key(first):
+                raise SubmissionError(f"{run.folder}: {label} differs from {runs[0].folder}'s; one submission is one camera system")
+    spec = camera_from_dump(first["camera"]["spec"], source=f"{runs[0].folder}/results.json camera.spec")
+    mtf50, mtf50_source = _mtf50(spec) if measure_mtf else (
+        (spec.mtf50_group_cy_per_mm, "published_group") if spec.mtf50_group_cy_per_mm is not None else (None, "none"))
+    det = first["detector"]
+    submission = {
+        "format": SUBMISSION_FORMAT,
+        "name": name,
+        "submitter": submitter,
+        "created_at": created_at or created_at_now(),
+        "package_version": __version__,
+        "camera": {"name": spec.name, "spec_sha256": spec.sha256(), "spec": spec.model_dump(mode="json"),
+                   "mtf50_cy_per_mm": mtf50, "mtf50_source": mtf50_source},
+        "isp": spec.isp.model_dump(mode="json"),
+        "detector": {"name": det["name"], "family": det["family"], "sha256": det["sha256"], "licence": _detector_licence(det),
+                     "input_size": det["input_size"], "score_threshold": det["score_threshold"],
+                     "multi_label": bool(det.get("multi_label", False))},
+        "collection": {k: first["collection"][k] for k in ("name", "protocol", "manifest_sha256")},
+        "scoring": {"backend": first.get("scoring_backend", "faster-coco-eval"), "category_id": 3,
+                    "bootstrap_resamples": n_resamples, "bootstrap_seed": seed},
+        "conditions": {run.condition: condition_entry(run, n_resamples=n_resamples, seed=seed) for run in runs},
+    }  # fmt: skip
+    if notes:
+        submission["notes"] = notes
+    if spec.sha256() != first["camera"]["spec_sha256"]:
+        raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")
+    return validate_submission(submission, protocols=protocols, source=name)
+
+
+def dumps_submission(submission: dict) -> str:
+    """Canonical text of a submission: sorted keys, 1-space indent, trailing newline."""
+    return json.dumps(submission, indent=1, sort_keys=True, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+def write_submission(submission: dict, leaderboard_dir: str | Path = "leaderboard") -> Path:
+    """Validate against the leaderboard (protocols, duplicates), then write ``submissions/<name>.json`` atomically."""
+    leaderboard_dir = Path(leaderboard_dir)
+    validate_submission(submission, protocols=load_protocols(leaderboard_dir), source=submission.get("name", "submission"))
+    check_not_duplicate(submission, leaderboard_dir)
+    text = dumps_submission(submission)
+    if len(text.encode("utf-8")) > MAX_SUBMISSION_BYTES:
+        raise SubmissionError(f"{submission['name']}: submission over the 5 MB limit")
+    return atomic_write_text(leaderboard_dir / SUBMISSIONS / f"{submission['name']}.json", text)

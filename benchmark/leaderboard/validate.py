@@ -1,0 +1,267 @@
+"""Validation of a submission: file, JSON, schema, then what the schema cannot say.
+
+Each refusal is a :class:`SubmissionError` with a one-line reason. The checks beyond the
+schema: the camera spec's sha256 matches its content; the protocol and manifest hash are
+accepted (:mod:`benchmark.leaderboard.protocols`); every condition has exactly the
+protocol's distances and the required conditions are there; OD50 follows from the AP
+curve (:func:`benchmark.scoring.od50`); the name is new on the leaderboard; and, given the
+detections file and ground truth, AP recomputed with :func:`benchmark.scoring.ap_by_distance`
+equals the claimed AP within 1e-6.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+from datetime import datetime
+from pathlib import Path
+
+from benchmark.leaderboard.files import sha256_file
+from benchmark.leaderboard.protocols import Protocol, load_protocols
+from benchmark.leaderboard.schema import SubmissionError, check_schema, loads_strict
+
+MAX_SUBMISSION_BYTES = 5 * 1024 * 1024
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$")
+AP_TOLERANCE = 1e-6
+OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
+SUBMISSIONS = "submissions"
+
+
+def check_name(name: str) -> str:
+    """``name`` if it is a safe file stem (letters, digits, ``._-``; no separators, no leading dot)."""
+    if not isinstance(name, str) or not NAME_PATTERN.match(name):
+        raise SubmissionError(
+            f"unsafe submission name {name!r}: use 1-80 letters, digits, '.', '_' or '-', starting with a letter or digit"
+        )
+    return name
+
+
+def read_submission_file(path: str | Path) -> dict:
+    """Read a submission file: safe ``<name>.json`` file name, at most 5 MB, strict JSON, an object."""
+    path = Path(path)
+    if path.suffix != ".json":
+        raise SubmissionError(f"{path.name}: a submission file name must end in .json")
+    check_name(path.stem)
+    if not path.is_file():
+        raise SubmissionError(f"{path}: no such file")
+    size = path.stat().st_size
+    if size > MAX_SUBMISSION_BYTES:
+        raise SubmissionError(f"{path.name}: {size} bytes, over the {MAX_SUBMISSION_BYTES // (1024 * 1024)} MB limit")
+    data = loads_strict(path.read_bytes(), path.name)
+    if isinstance(data, dict) and isinstance(data.get("name"), str) and data["name"] != path.stem:
+        raise SubmissionError(f"{path.name}: file name must be <name>.json, and name is {data['name']!r}")
+    return data
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def _without_computed(model, data):
+    """A ``model_dump`` with the computed fields (e.g. ``sensor.width_px``) taken out, for re-validation."""
+    from pydantic import BaseModel
+
+    if not isinstance(data, dict):
+        return data
+    out = {k: v for k, v in data.items() if k not in model.model_computed_fields}
+    for key, field in model.model_fields.items():
+        ann = field.annotation
+        if key in out and isinstance(ann, type) and issubclass(ann, BaseModel):
+            out[key] = _without_computed(ann, out[key])
+    return out
+
+
+def camera_from_dump(spec: dict, source: str = "camera.spec"):
+    """The :class:`CameraSpec` of a resolved dump (as in results.json); the dump must be exactly its re-dump."""
+    from benchmark.cameras import CameraSpec, camera_from_dict
+
+    try:
+        camera = camera_from_dict(_without_computed(CameraSpec, spec), source=source)
+    except ValueError as exc:
+        raise SubmissionError(str(exc).splitlines()[0]) from None
+    if camera.model_dump(mode="json") != spec:
+        raise SubmissionError(f"{source}: not a resolved camera spec (its fields or derived values differ from the re-resolved spec)")
+    return camera
+
+
+def _check_camera(data: dict, source: str) -> None:
+    cam = data["camera"]
+    # the hash of the content as given (CameraSpec.canonical_json's formula), then that content must be a resolved spec
+    canonical = json.dumps(cam["spec"], sort_keys=True, separators=(",", ":"))
+    actual = hashlib.sha256(canonical.encode("utf-8")).hexdigest()
+    if actual != cam["spec_sha256"]:
+        raise SubmissionError(
+            f"{source}: camera.spec_sha256 {cam['spec_sha256'][:12]}... does not match the spec's content ({actual[:12]}...)"
+        )
+    try:
+        spec = camera_from_dump(cam["spec"])
+    except SubmissionError as exc:
+        raise SubmissionError(f"{source}: {exc}") from None
+    if cam["name"] != spec.name:
+        raise SubmissionError(f"{source}: camera.name {cam['name']!r} differs from camera.spec.name {spec.name!r}")
+    if data["isp"] != spec.isp.model_dump(mode="json"):
+        raise SubmissionError(f"{source}: isp differs from camera.spec.isp (it must be a copy of it)")
+    value, kind = cam["mtf50_cy_per_mm"], cam["mtf50_source"]
+    if kind == "none" and value is not None:
+        raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm must be null when mtf50_source is 'none'")
+    if kind == "published_group" and value != spec.mtf50_group_cy_per_mm:
+        raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm {value} is not the spec's published group {spec.mtf50_group_cy_per_mm}")
+    if kind == "measured" and value is None:
+        raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm is null but mtf50_source is 'measured'")
+
+
+def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) -> None:
+    from benchmark.scoring import od50
+
+    where = f"{source}: conditions.{cname}.per_distance"
+    seen = [float(r["distance_m"]) for r in cond["per_distance"]]
+    for d in seen:
+        if seen.count(d) > 1:
+            raise SubmissionError(f"{where}: distance {d:g} m appears {seen.count(d)} times")
+    missing = [d for d in protocol.distances_m if d not in seen]
+    if missing:
+        required = ", ".join(f"{d:g}" for d in protocol.distances_m)
+        raise SubmissionError(f"{where}: missing distance(s) {', '.join(f'{d:g}' for d in missing)} m (protocol {protocol.name!r} requires {required} m)")
+    extra = [d for d in seen if d not in protocol.distances_m]
+    if extra:
+        raise SubmissionError(f"{where}: distance {extra[0]:g} m is not one of protocol {protocol.name!r}'s distances")
+    rows = sorted(cond["per_distance"], key=lambda r: r["distance_m"])
+    expected = _finite_or_none(od50([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
+    claimed = cond["od50_m"]
+    if (expected is None) != (claimed is None) or (
+        expected is not None and abs(expected - claimed) > OD50_TOLERANCE_M
+    ):
+        show = "inf" if expected is None else f"{expected:.3f} m"
+        raise SubmissionError(f"{source}: conditions.{cname}.od50_m = {claimed} does not follow from its AP per distance (OD50 = {show})")
+
+
+def validate_submission(data: object, *, protocols: dict[str, Protocol] | None = None, source: str = "submission") -> dict:
+    """Schema and consistency checks of a parsed submission; returns it unchanged."""
+    check_schema(data, source)
+    assert isinstance(data, dict)
+    check_name(data["name"])
+    try:
+        datetime.strptime(data["created_at"], "%Y-%m-%dT%H:%M:%SZ")
+    except ValueError:
+        raise SubmissionError(f"{source}: created_at {data['created_at']!r} is not a valid UTC date and time") from None
+    _check_camera(data, source)
+    protocols = load_protocols() if protocols is None else protocols
+    col = data["collection"]
+    protocol = protocols.get(col["protocol"])
+    if protocol is None:
+        raise SubmissionError(
+            f"{source}: protocol {col['protocol']!r} is not accepted by this leaderboard (accepted: {', '.join(protocols)})"
+        )
+    if col["manifest_sha256"] not in protocol.manifests_sha256:
+        raise SubmissionError(
+            f"{source}: collection.manifest_sha256 {col['manifest_sha256'][:12]}... is not an accepted manifest of protocol {protocol.name!r}"
+        )
+    conditions = data["conditions"]
+    for required in protocol.required_conditions:
+        if required not in conditions:
+            raise SubmissionError(
+                f"{source}: conditions: missing required condition {required!r} (protocol {protocol.name!r} requires: {', '.join(protocol.required_conditions)})"
+            )
+    for cname in sorted(conditions):
+        if cname not in protocol.conditions:
+            raise SubmissionError(
+                f"{source}: conditions.{cname}: not a condition of protocol {protocol.name!r} (allowed: {', '.join(protocol.conditions)})"
+            )
+        _check_condition(cname, conditions[cname], protocol, source)
+    return data
+
+
+def _identity(data: dict) -> tuple:
+    return (
+        data["camera"]["spec_sha256"], data["detector"]["sha256"], data["collection"]["manifest_sha256"],
+        tuple(sorted(c["detections_sha256"] for c in data["conditions"].values())),
+    )
+
+
+def check_not_duplicate(data: dict, leaderboard_dir: str | Path, *, path: str | Path | None = None) -> None:
+    """Refuse a name already taken, or the same system and detections under another name.
+
+    ``path``: where ``data`` was read from; the file itself is not its own duplicate.
+    """
+    folder = Path(leaderboard_dir) / SUBMISSIONS
+    target = folder / f"{data['name']}.json"
+    own = Path(path).resolve() if path is not None else None
+    if target.exists() and target.resolve() != own:
+        raise SubmissionError(f"duplicate name: {target} already exists (choose another --name)")
+    mine = _identity(data)
+    for other in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+        if other.resolve() in (own, target.resolve()):
+            continue
+        try:
+            theirs = _identity(json.loads(other.read_text(encoding="utf-8")))
+        except (ValueError, KeyError, TypeError, AttributeError, OSError):
+            continue  # a broken file is reported when the table is rendered
+        if theirs == mine:
+            raise SubmissionError(f"duplicate: {other.name} has the same camera, detector, collection and detections")
+
+
+def verify_detections(data: dict, detections: list[str | Path], groundtruth: str | Path, *, source: str = "submission") -> list[str]:
+    """Recompute AP of the conditions whose detections files are given; returns those conditions.
+
+    Each file is matched to a condition by its sha256; ``groundtruth`` is the collection's
+    ground truth on the camera's grid (a run folder's ``groundtruth.json``).
+    """
+    from benchmark.scoring import ap_by_distance
+
+    try:
+        gt = json.loads(Path(groundtruth).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SubmissionError(f"groundtruth {groundtruth}: cannot read ({type(exc).__name__})") from None
+    gt_manifest = (gt.get("info") or {}).get("manifest_sha256") if isinstance(gt, dict) else None
+    if gt_manifest is not None and gt_manifest != data["collection"]["manifest_sha256"]:
+        raise SubmissionError(f"groundtruth {Path(groundtruth).name} is of manifest {gt_manifest[:12]}..., not the submission's collection")
+    by_hash = {c["detections_sha256"]: name for name, c in data["conditions"].items()}
+    verified = []
+    for path in detections:
+        path = Path(path)
+        if not path.is_file():
+            raise SubmissionError(f"detections {path}: no such file")
+        digest = sha256_file(path)
+        cname = by_hash.get(digest)
+        if cname is None:
+            raise SubmissionError(f"detections {path.name} (sha256 {digest[:12]}...) is not the file any condition was computed from")
+        try:
+            dets = json.loads(path.read_text(encoding="utf-8"))
+            rows = ap_by_distance(gt, dets, backend=data["scoring"]["backend"])
+        except (ValueError, KeyError, TypeError) as exc:
+            raise SubmissionError(f"detections {path.name}: cannot score ({type(exc).__name__}: {exc})".splitlines()[0]) from None
+        recomputed = {float(r["distance_m"]): r for r in rows}
+        for claimed in data["conditions"][cname]["per_distance"]:
+            r = recomputed.get(float(claimed["distance_m"]))
+            if r is None or r["n_images"] != claimed["n_images"]:
+                raise SubmissionError(f"{source}: conditions.{cname}: the ground truth has no images at {claimed['distance_m']:g} m matching n_images {claimed['n_images']}")
+            for key in ("ap", "ap50"):
+                if not abs(float(r[key]) - claimed[key]) <= AP_TOLERANCE:
+                    raise SubmissionError(
+                        f"{source}: conditions.{cname}: {key.upper()} at {claimed['distance_m']:g} m is {claimed[key]:.6f} "
+                        f"but {float(r[key]):.6f} recomputed from {path.name}"
+                    )
+        verified.append(cname)
+    return verified
+
+
+def check_submission_file(
+    path: str | Path,
+    *,
+    leaderboard_dir: str | Path | None = None,
+    detections: list[str | Path] = (),
+    groundtruth: str | Path | None = None,
+) -> dict:
+    """Everything ``benchmark submit --check`` does; returns the submission. Touches no file."""
+    path = Path(path)
+    data = read_submission_file(path)
+    validate_submission(data, protocols=load_protocols(leaderboard_dir), source=path.name)
+    if leaderboard_dir is not None:
+        check_not_duplicate(data, leaderboard_dir, path=path)
+    if detections:
+        if groundtruth is None:
+            raise SubmissionError("--detections needs --groundtruth (the run folder's groundtruth.json)")
+        verify_detections(data, list(detections), groundtruth, source=path.name)
+    return data

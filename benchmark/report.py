@@ -1,0 +1,263 @@
+"""``benchmark report``: one self-contained HTML page from a sweep or a single run folder.
+
+The page holds AP-vs-distance curves per condition (one line per camera), the System
+Performance Maps and OD50 vs MTF50 (:mod:`benchmark.spm`; sweep folders with two or
+more MTF50 values only), a table (camera, MTF50, condition, OD50 ± SD, AP per
+distance), and per distance a strip of camera images, cropped around the car at the
+same field of view for every camera, with the ground-truth box (green) and the best
+car detection (red, with its score). Every image is embedded as base64 PNG and the
+page loads nothing from elsewhere; the figures are also written as PNG and SVG next
+to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from benchmark import spm  # noqa: E402
+from benchmark.sweep import TABLE_COLUMNS, camera_mtf50, load_sweep, run_name, run_od50  # noqa: E402
+
+GT_COLOUR, DET_COLOUR = (0, 200, 0), (230, 0, 0)
+CAR_CATEGORY_ID = 3
+THUMB_WIDTH_PX = 240
+
+
+def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[str, str], Path], dict]:
+    """(AP table, OD50 table, run folder per (camera, condition), metadata) of a sweep
+    folder (``sweep.csv``) or of one ``benchmark run`` folder (``results.json``)."""
+    root = Path(results_dir)
+    if (root / "sweep.csv").is_file():
+        table, od50 = load_sweep(root)
+        meta = json.loads((root / "sweep.json").read_text()) if (root / "sweep.json").is_file() else {}
+        runs = {(c, k): root / "runs" / run_name(c, k) for c, k in od50[["camera", "condition"]].itertuples(index=False)}
+        return table, od50, runs, meta
+    if not (root / "results.json").is_file():
+        raise ValueError(f"{root} is neither a sweep folder (sweep.csv) nor a run folder (results.json)")
+    results = json.loads((root / "results.json").read_text())
+    cam = results["camera"]
+    mtf50, source = _run_mtf50(cam)
+    ident = {"camera": cam["name"], "pixel_um": cam["pixel_um"], "f_number": cam["f_number"],
+             "mtf50_cy_per_mm": mtf50, "mtf50_source": source, "condition": results["condition"]}
+    table = pd.DataFrame([{**ident, **{k: r[k] for k in ("distance_m", "ap", "ap50", "n_images")}}
+                          for r in results["per_distance"]], columns=TABLE_COLUMNS)
+    try:
+        boot = run_od50(root, n_resamples=200, seed=int(results.get("seed", 0)))
+    except ValueError:  # one environment: no bootstrap
+        boot = {"od50_m": results.get("od50_m"), "sd_m": None, "ci95_m": [None, None]}
+    od50 = pd.DataFrame([{**ident, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
+                          "ci95_lo_m": _num(boot["ci95_m"][0]), "ci95_hi_m": _num(boot["ci95_m"][1])}])
+    meta = {"collection": results.get("collection", {}), "detector": results.get("detector", {}), "seed": results.get("seed")}
+    return table, od50, {(cam["name"], results["condition"]): root}, meta
+
+
+def plot_ap_curves(table: pd.DataFrame, out=None):
+    """AP vs distance, one panel per condition, one line per camera (seaborn), cameras
+    coloured by MTF50 (paper Fig. 5)."""
+    import seaborn as sns
+
+    order = table.groupby("camera")["mtf50_cy_per_mm"].first().sort_values(kind="stable")
+    labels = {c: f"{c} ({m:.0f} cy/mm)" if np.isfinite(m) else c for c, m in order.items()}
+    data = table.assign(camera=table["camera"].map(labels))
+    conditions = list(dict.fromkeys(table["condition"]))
+    fig, axes = plt.subplots(1, len(conditions), figsize=(5.0 * len(conditions) + 1.6, 3.8), squeeze=False,
+                             sharey=True, constrained_layout=True)
+    palette = dict(zip(labels.values(), sns.color_palette("viridis", len(labels))))
+    for ax, condition in zip(axes[0], conditions):
+        sns.lineplot(data=data[data["condition"] == condition], x="distance_m", y="ap", hue="camera",
+                     hue_order=list(labels.values()), palette=palette, marker="o", ax=ax, legend=ax is axes[0][-1])
+        ax.axhline(0.5, color="grey", lw=0.8, ls=":")
+        ax.set(title=condition, xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)", ylim=(-0.02, 1.02))
+    legend = axes[0][-1].get_legend()
+    if legend is not None:
+        sns.move_legend(axes[0][-1], "upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7, title="camera (MTF50)")
+    if out is not None:
+        spm.save_figure(fig, out)
+    return fig
+
+
+def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
+    """One row per camera × condition: MTF50, OD50 ± SD, 95 % interval, AP per distance."""
+    ap = table.pivot_table(index=["camera", "condition"], columns="distance_m", values="ap", sort=False)
+    ap.columns = [f"AP {d:g} m" for d in ap.columns]
+    rows = od50.set_index(["camera", "condition"])
+    out = pd.DataFrame({
+        "MTF50 (cy/mm)": rows["mtf50_cy_per_mm"].map(lambda v: f"{v:.1f}" if np.isfinite(v) else "–"),
+        "OD50 ± SD (m)": [_pm(o, s) for o, s in zip(rows["od50_m"], rows["sd_m"])],
+        "95 % interval (m)": [_interval(lo, hi) for lo, hi in zip(rows.get("ci95_lo_m", np.nan), rows.get("ci95_hi_m", np.nan))],
+    }, index=rows.index)
+    return out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+
+
+def crop_with_boxes(image_path: Path, gt_box, det, *, width_px: int = THUMB_WIDTH_PX):
+    """A PIL thumbnail around the car: the crop spans 4 car widths (at least 15 % of the
+    frame), the same fraction of the field of view for every camera; boxes drawn on the
+    thumbnail so their lines stay crisp. ``gt_box``/``det['bbox']`` are COCO xywh pixels."""
+    from PIL import Image, ImageDraw
+
+    img = Image.open(image_path).convert("RGB")
+    w, h = img.size
+    bx, by, bw, bh = gt_box
+    frac = float(np.clip(4.0 * bw / w, 0.15, 1.0))
+    cw, ch = frac * w, frac * h
+    x0 = float(np.clip(bx + bw / 2 - cw / 2, 0, w - cw))
+    y0 = float(np.clip(by + bh / 2 - ch / 2, 0, h - ch))
+    scale = width_px / cw
+    thumb_h = max(1, round(ch * scale))
+    resample = Image.Resampling.NEAREST if scale >= 1 else Image.Resampling.LANCZOS  # show the pixels
+    thumb = img.resize((width_px, thumb_h), resample, box=(x0, y0, x0 + cw, y0 + ch))
+    draw = ImageDraw.Draw(thumb)
+
+    def rect(box):
+        x, y, bw_, bh_ = box
+        return [(x - x0) * scale, (y - y0) * scale, (x + bw_ - x0) * scale, (y + bh_ - y0) * scale]
+
+    draw.rectangle(rect(gt_box), outline=GT_COLOUR, width=2)
+    if det is not None:
+        r = rect(det["bbox"])
+        draw.rectangle(r, outline=DET_COLOUR, width=2)
+        draw.text((max(0, r[0]), max(0, r[1] - 11)), f"car {det['score']:.2f}", fill=DET_COLOUR)
+    return thumb
+
+
+def image_strips(runs: dict[tuple[str, str], Path], table: pd.DataFrame) -> list[dict]:
+    """Per distance and condition, one thumbnail per camera (first environment)."""
+    strips: dict[tuple[float, str], list] = {}
+    for (camera, condition), run_dir in runs.items():
+        gt_path, det_path = run_dir / "groundtruth.json", run_dir / "detections.json"
+        if not gt_path.is_file() or not (run_dir / "images").is_dir():
+            continue
+        gt = json.loads(gt_path.read_text())
+        dets = json.loads(det_path.read_text()) if det_path.is_file() else []
+        env = min(im["environment_id"] for im in gt["images"])
+        boxes = {a["image_id"]: a["bbox"] for a in gt["annotations"] if a["category_id"] == CAR_CATEGORY_ID}
+        best: dict[int, dict] = {}
+        for d in dets:
+            if d["category_id"] == CAR_CATEGORY_ID and d["score"] > best.get(d["image_id"], {"score": -1})["score"]:
+                best[d["image_id"]] = d
+        for im in gt["images"]:
+            path = run_dir / "images" / f"{im['scene_id']}.png"
+            if im["environment_id"] != env or im["id"] not in boxes or not path.is_file():
+                continue
+            ap = table.query("camera == @camera and condition == @condition and distance_m == @im['distance_m']")["ap"]
+            strips.setdefault((float(im["distance_m"]), condition), []).append({
+                "camera": camera, "scene_id": im["scene_id"], "ap": float(ap.iloc[0]) if len(ap) else float("nan"),
+                "png": _png_base64(crop_with_boxes(path, boxes[im["id"]], best.get(im["id"]))),
+                "score": best[im["id"]]["score"] if im["id"] in best else None,
+            })
+    order = {c: k for k, c in enumerate(dict.fromkeys(table["condition"]))}
+    return [{"distance_m": d, "condition": c, "images": v} for (d, c), v in sorted(strips.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], 99)))]
+
+
+def report(results_dir, out=None) -> Path:
+    """Write ``report.html`` (default: in ``results_dir``) and its figures; returns the page's path."""
+    results_dir = Path(results_dir)
+    table, od50, runs, meta = load_results(results_dir)
+    out = Path(out) if out is not None else results_dir / "report.html"
+    fig_dir = out.parent / "figures"
+    figures = []  # (title, caption, figure)
+    figures.append(("AP vs distance", "COCO AP@[.5:.95] for the car at each distance; one line per camera, "
+                    "coloured by MTF50; the dotted line is AP 0.5 (OD50).", plot_ap_curves(table, fig_dir / "ap_vs_distance")))
+    per_cond = table.groupby("condition")["mtf50_cy_per_mm"].nunique()
+    if table["mtf50_cy_per_mm"].notna().all() and (per_cond >= 2).all():
+        mark = 100.0 if table["mtf50_cy_per_mm"].min() <= 100 <= table["mtf50_cy_per_mm"].max() else None
+        figures.append(("System Performance Maps", "AP over (distance, MTF50), linearly interpolated between the "
+                        "measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5; dashed: OD50 at "
+                        "MTF50 100 cy/mm.", spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark)))
+    if od50["camera"].nunique() >= 2 and od50["mtf50_cy_per_mm"].notna().all():
+        figures.append(("OD50 vs MTF50", "OD50 ± bootstrap SD over environments; least-squares line per "
+                        "condition, its slope in the legend.", spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50")))
+    sections = []
+    for title, caption, fig in figures:
+        sections.append(f"<h2>{html.escape(title)}</h2><figure><img alt='{html.escape(title)}' src='data:image/png;base64,"
+                        f"{_fig_base64(fig)}'><figcaption>{html.escape(caption)}</figcaption></figure>")
+        plt.close(fig)
+    summary = summary_table(table, od50)
+    sections.append("<h2>Results</h2>" + summary.to_html(index=False, classes="results", border=0, escape=True))
+    strips = image_strips(runs, table)
+    if strips:
+        sections.append("<h2>Images</h2><p>First environment, cropped around the car at the same field of view for "
+                        "every camera; <span style='color:#0a0'>green</span>: ground truth, "
+                        "<span style='color:#e00'>red</span>: best car detection and its score.</p>")
+        for s in strips:
+            cells = "".join(_thumb_html(i) for i in s["images"])
+            sections.append(f"<h3>{s['distance_m']:g} m · {html.escape(s['condition'])}</h3><div class='strip'>{cells}</div>")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(_page(meta, "\n".join(sections)), encoding="utf-8")
+    summary.to_csv(out.parent / "report_table.csv", index=False)
+    return out
+
+
+def _thumb_html(item: dict) -> str:
+    caption = f"{item['camera']} · AP {item['ap']:.2f}"
+    caption += " · no car detection" if item["score"] is None else f" · best car {item['score']:.2f}"
+    return (f"<figure class='thumb'><img alt='{html.escape(item['scene_id'])}' src='data:image/png;base64,{item['png']}'>"
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _page(meta: dict, body: str) -> str:
+    col, det = meta.get("collection", {}), meta.get("detector", {})
+    facts = [("collection", f"{col.get('name', '?')} (manifest {str(col.get('manifest_sha256', ''))[:12]})"),
+             ("detector", f"{det.get('name', '?')}, input size {det.get('input_size', '?')}"),
+             ("seed", meta.get("seed")), ("bootstrap resamples", meta.get("n_resamples")),
+             ("MTF50 source", meta.get("mtf_source"))]
+    items = "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(str(v))}</li>" for k, v in facts if v is not None)
+    style = ("body{font-family:system-ui,sans-serif;margin:2em;max-width:1400px;color:#222}"
+             "table.results{border-collapse:collapse;font-size:0.85em}"
+             "table.results td,table.results th{padding:3px 8px;border-bottom:1px solid #ddd;text-align:right}"
+             "figure{margin:0.5em 0}figure img{max-width:100%}.strip{display:flex;flex-wrap:wrap;gap:8px}"
+             ".thumb{margin:0}.thumb figcaption{font-size:0.75em;text-align:center}")
+    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>metricscenes report</title>"
+            f"<style>{style}</style></head><body><h1>metricscenes benchmark report</h1><ul>{items}</ul>\n{body}\n</body></html>\n")
+
+
+def _run_mtf50(cam: dict) -> tuple[float, str]:
+    """MTF50 of a run's camera from the spec recorded in its results.json."""
+    from benchmark.cameras import camera_from_dict
+
+    spec = json.loads(json.dumps(cam.get("spec") or {}))
+    spec.get("sensor", {}).pop("width_px", None), spec.get("sensor", {}).pop("height_px", None)  # computed fields
+    try:
+        return camera_mtf50(camera_from_dict(spec))
+    except ValueError:
+        return float("nan"), "none"
+
+
+def _png_base64(image) -> str:
+    buf = io.BytesIO()
+    image.save(buf, format="PNG")
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _fig_base64(fig) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _num(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
+def _pm(value: float, sd: float) -> str:
+    if not np.isfinite(value):
+        return "∞" if value == math.inf else "–"
+    return f"{value:.1f} ± {sd:.1f}" if np.isfinite(sd) else f"{value:.1f}"
+
+
+def _interval(lo: float, hi: float) -> str:
+    if np.isnan(lo) or np.isnan(hi):
+        return "–"
+    return f"[{lo:.1f}, {hi:.1f}]".replace("inf", "∞")

@@ -1,0 +1,160 @@
+"""The image sensor: irradiance to electrons to volts to digital numbers (DN).
+
+Spectral integration (ISETCam ``sensorCompute``): a pixel of channel c collects
+
+    e⁻/s = A · FF · Σ_λ E(λ) · QE_c(λ) · IRcut(λ) · λ / (h c) · Δλ
+
+(A pixel area, FF fill factor, Δλ band width). The capture then follows ISETCam's
+noise order: signal (+ dark) electrons → Poisson shot noise → clip at the well →
+Gaussian read noise → volts (conversion gain) → PRNU (gain) and DSNU (offset) →
+analog gain and the offset that gives the black level → clip to [0, swing] →
+quantise (``adc_bits``).
+
+Every noise source can be switched off (:class:`NoiseOptions`); temporal noise comes
+from ``np.random.default_rng(seed)`` (same seed, same raw); the fixed-pattern maps come
+from the sensor's own ``fpn_seed`` (the same sensor unit in every capture).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from benchmark.cameras.registry import DATA_DIR
+from benchmark.cameras.spec import SensorSpec
+from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j
+
+CHANNELS = ("r", "g", "b")
+
+
+@dataclass(frozen=True)
+class NoiseOptions:
+    """Which noise sources a capture draws (all on by default)."""
+
+    shot: bool = True
+    read: bool = True
+    dark: bool = True
+    prnu: bool = True
+    dsnu: bool = True
+
+    @classmethod
+    def off(cls) -> "NoiseOptions":
+        return cls(shot=False, read=False, dark=False, prnu=False, dsnu=False)
+
+
+@functools.lru_cache(maxsize=16)
+def _read_qe_table(path: str) -> tuple[np.ndarray, np.ndarray]:
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    names = table.dtype.names
+    missing = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b") if c not in names]
+    if missing:
+        raise ValueError(f"{path}: QE table lacks column(s) {', '.join(missing)}")
+    qe = np.stack([table[f"qe_{c}"] for c in CHANNELS])
+    if "ir_cut_transmittance" in names:
+        qe = qe * table["ir_cut_transmittance"][None, :]
+    return np.asarray(table["wavelength_nm"], float), qe
+
+
+def effective_qe(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
+    """Colour-filter QE × IR-cut transmittance, (3, bands), interpolated to the bands."""
+    path = DATA_DIR / sensor.qe if (DATA_DIR / sensor.qe).is_file() else Path(sensor.qe)
+    if not path.is_file():
+        raise ValueError(f"sensor.qe: QE file {sensor.qe!r} not found (packaged name or path)")
+    wl, qe = _read_qe_table(str(path.resolve()))
+    return np.stack([np.interp(wavelengths_nm, wl, q, left=0.0, right=0.0) for q in qe])
+
+
+def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
+    """Electrons·s⁻¹ per pixel per W·m⁻²·nm⁻¹ of irradiance in each band, (3, bands):
+    QE · IRcut · λ/(hc) · Δλ · pixel area · fill factor."""
+    photons_per_j = 1.0 / photon_energy_j(wavelengths_nm)
+    area = sensor.pixel_area_m2 * sensor.fill_factor
+    return effective_qe(sensor, wavelengths_nm) * photons_per_j[None, :] * BAND_WIDTH_NM * area
+
+
+def cfa_index(rows: int, cols: int, cfa: str = "RGGB") -> np.ndarray:
+    """Channel index (0 R, 1 G, 2 B) of every pixel of a Bayer mosaic, (rows, cols) uint8."""
+    lut = {"R": 0, "G": 1, "B": 2}
+    tile = np.array([[lut[cfa[0]], lut[cfa[1]]], [lut[cfa[2]], lut[cfa[3]]]], dtype=np.uint8)
+    return np.tile(tile, ((rows + 1) // 2, (cols + 1) // 2))[:rows, :cols]
+
+
+def mosaic(channels: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
+    """Sample (3, rows, cols) channel images on the Bayer pattern: (rows, cols)."""
+    _, rows, cols = channels.shape
+    out = np.empty((rows, cols), dtype=channels.dtype)
+    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
+        out[dy::2, dx::2] = channels["RGB".index(ch), dy::2, dx::2]
+    return out
+
+
+def fixed_pattern(sensor: SensorSpec, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """PRNU gain map (mean 1) and DSNU offset map (V) of this sensor unit (``fpn_seed``)."""
+    rng = np.random.default_rng([sensor.fpn_seed, 0x5E45])
+    gain = 1.0 + sensor.prnu_fraction * rng.standard_normal(shape, dtype=np.float32)
+    offset = sensor.dsnu_v * rng.standard_normal(shape, dtype=np.float32)
+    return gain, offset
+
+
+def capture_volts(
+    electron_rate: np.ndarray,
+    exposure_s: float,
+    sensor: SensorSpec,
+    rng: np.random.Generator | None,
+    noise: NoiseOptions = NoiseOptions(),
+) -> np.ndarray:
+    """Pixel voltage after analog gain and black-level offset, clipped to the swing.
+
+    Args:
+        electron_rate: (rows, cols) noise-free signal, electrons·s⁻¹ (the mosaic).
+        exposure_s: integration time, s.
+        rng: temporal-noise generator (needed when shot or read noise is on).
+    """
+    electrons = electron_rate.astype(np.float64) * exposure_s
+    if noise.dark and sensor.dark_current_e_per_s > 0:
+        electrons = electrons + sensor.dark_current_e_per_s * exposure_s
+    if noise.shot:
+        electrons = rng.poisson(np.maximum(electrons, 0.0)).astype(np.float64)
+    electrons = np.minimum(electrons, sensor.well_capacity_e)  # the photodiode's well
+    if noise.read and sensor.read_noise_e > 0:
+        electrons = electrons + sensor.read_noise_e * rng.standard_normal(electrons.shape)
+    volts = electrons * (sensor.conversion_gain_uv_per_e * 1e-6)
+    if (noise.prnu and sensor.prnu_fraction > 0) or (noise.dsnu and sensor.dsnu_v > 0):
+        gain, offset = fixed_pattern(sensor, volts.shape)
+        volts = volts * (gain if noise.prnu else 1.0) + (offset if noise.dsnu else 0.0)
+    volts = volts * sensor.analog_gain + sensor.black_level_dn * sensor.lsb_v
+    return np.clip(volts, 0.0, sensor.voltage_swing_v)
+
+
+def quantize(volts: np.ndarray, sensor: SensorSpec) -> np.ndarray:
+    """Linear ADC: DN = round(V / LSB), uint16 in [0, 2^bits − 1]."""
+    dn = np.rint(volts / sensor.lsb_v)
+    return np.clip(dn, 0, sensor.white_level_dn).astype(np.uint16)
+
+
+def capture_dn(
+    electron_rate: np.ndarray,
+    exposure_s: float,
+    sensor: SensorSpec,
+    rng: np.random.Generator | None,
+    noise: NoiseOptions = NoiseOptions(),
+) -> np.ndarray:
+    """Raw Bayer DN (rows, cols) uint16 of one exposure: :func:`capture_volts` then
+    :func:`quantize`."""
+    return quantize(capture_volts(electron_rate, exposure_s, sensor, rng, noise), sensor)
+
+
+def signal_volts_per_electron(sensor: SensorSpec) -> float:
+    """Volts at the ADC per signal electron (conversion gain × analog gain)."""
+    return sensor.conversion_gain_uv_per_e * 1e-6 * sensor.analog_gain
+
+
+def saturation_electrons(sensor: SensorSpec) -> float:
+    """Signal electrons at which the raw data saturates: the well, or the ADC white level
+    less the black-level offset (the offset uses part of the swing, as in ISETCam),
+    whichever comes first. IMX363 defaults: min(6000, 959 DN / 0.1705 DN/e⁻) = 5626 e⁻."""
+    adc_e = (sensor.white_level_dn - sensor.black_level_dn) * sensor.lsb_v / signal_volts_per_electron(sensor)
+    return float(min(sensor.well_capacity_e, adc_e))

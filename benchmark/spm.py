@@ -1,0 +1,195 @@
+"""System Performance Maps (SPMs) and OD50 vs MTF50 (Liu et al., EI 2023, Figs. 6-8).
+
+An SPM shows AP as a function of one system or scene factor and object distance: the
+measured points (camera MTF50 × distance, or illuminance × distance) are interpolated
+on a regular grid (``scipy.interpolate.griddata``, linear on the Delaunay triangulation
+of the points, axes rescaled to the unit square so neither unit dominates), drawn as
+filled contours with labelled iso-AP lines, and the measured points on top. The
+AP = 0.5 line is the OD50 contour.
+
+Every plotting function returns the :class:`matplotlib.figure.Figure` and, given
+``out``, writes ``out.png`` and ``out.svg`` (the Agg backend: no display needed).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only; never a window
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+from scipy.interpolate import griddata  # noqa: E402
+
+AP_LEVELS = np.linspace(0.0, 1.0, 11)
+ISO_AP_LEVELS = np.round(np.linspace(0.1, 0.9, 9), 2)
+CONDITION_COLOURS = {"day": "tab:orange", "dusk": "tab:purple", "night": "tab:blue"}
+
+
+def save_figure(fig, out) -> list[Path]:
+    """Write ``out.png`` (150 dpi) and ``out.svg``; returns the two paths."""
+    out = Path(out)
+    out = out.with_suffix("") if out.suffix.lower() in (".png", ".svg") else out
+    out.parent.mkdir(parents=True, exist_ok=True)
+    paths = [out.with_name(out.name + ".png"), out.with_name(out.name + ".svg")]
+    with plt.rc_context({"svg.hashsalt": "metricscenes", "svg.fonttype": "path"}):  # deterministic, font-free SVG
+        fig.savefig(paths[0], dpi=150, bbox_inches="tight")
+        fig.savefig(paths[1], bbox_inches="tight", metadata={"Date": None})
+    return paths
+
+
+def interpolate_map(x, y, z, *, n: int = 101, log_x: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Linear interpolation of scattered ``z(x, y)`` on a grid (the SPM surface).
+
+    Repeated (x, y) points are averaged first. The grid axes are ``n`` even steps over
+    the data's range (in log10 for ``log_x``) merged with every measured coordinate,
+    so each measured point is a grid node and the surface passes through it exactly.
+    Outside the points' convex hull the surface is NaN (no extrapolation).
+
+    Returns:
+        (gx of shape (nx,), gy of shape (ny,), gz of shape (ny, nx)).
+    """
+    frame = pd.DataFrame({"x": np.asarray(x, float), "y": np.asarray(y, float), "z": np.asarray(z, float)})
+    frame = frame[np.isfinite(frame).all(axis=1)]
+    if log_x:
+        if (frame["x"] <= 0).any():
+            raise ValueError("log_x needs positive x values (illuminance_lux > 0)")
+        frame["x"] = np.log10(frame["x"])
+    frame = frame.groupby(["x", "y"], as_index=False)["z"].mean()
+    if frame["x"].nunique() < 2 or frame["y"].nunique() < 2:
+        raise ValueError(f"an SPM needs two or more distinct values on each axis, got {frame['x'].nunique()} x "
+                         f"{frame['y'].nunique()} from {len(frame)} finite points")
+    gx = np.union1d(np.linspace(frame["x"].min(), frame["x"].max(), n), frame["x"].unique())
+    gy = np.union1d(np.linspace(frame["y"].min(), frame["y"].max(), n), frame["y"].unique())
+    mx, my = np.meshgrid(gx, gy)
+    gz = griddata(frame[["x", "y"]].to_numpy(), frame["z"].to_numpy(), (mx, my), method="linear", rescale=True)
+    return (10.0**gx if log_x else gx), gy, gz
+
+
+def _draw_map(ax, gx, gy, gz, px, py, *, cmap: str = "viridis"):
+    gz = np.clip(gz, 0.0, 1.0)  # round-off below AP 0 would leave the AP-0 region unfilled (NaN stays NaN)
+    filled = ax.contourf(gx, gy, gz, levels=AP_LEVELS, cmap=cmap, vmin=0.0, vmax=1.0, extend="neither")
+    lines = ax.contour(gx, gy, gz, levels=ISO_AP_LEVELS, colors="k", linewidths=0.7)
+    widths = [1.8 if abs(level - 0.5) < 1e-9 else 0.7 for level in lines.levels]  # the OD50 contour
+    lines.set_linewidths(widths)
+    ax.clabel(lines, fmt="%.1f", fontsize=7, inline=True)
+    ax.scatter(px, py, s=14, c="white", edgecolors="k", linewidths=0.6, zorder=3, label="measured")
+    return filled
+
+
+def _mark_od50(ax, gx, gy, gz, y_value: float) -> float | None:
+    """Dashed guide to the distance where AP = 0.5 at ``y_value`` (paper Fig. 6, left)."""
+    from benchmark.scoring import od50
+
+    if not gy.min() <= y_value <= gy.max():
+        return None
+    row = np.array([np.interp(y_value, gy, gz[:, j]) for j in range(gx.size)])
+    ok = np.isfinite(row)
+    if ok.sum() < 2:
+        return None
+    d = od50(gx[ok], row[ok])
+    if not np.isfinite(d) or not gx.min() <= d <= gx.max():
+        return None
+    ax.plot([gx.min(), d, d], [y_value, y_value, gy.min()], "--", color="crimson", lw=1.2,
+            label=f"OD50 = {d:.0f} m at {y_value:g}")
+    return float(d)
+
+
+def spm_mtf50(table: pd.DataFrame, out=None, *, conditions=None, mark_mtf50: float | None = None,
+              title: str | None = None):
+    """SPM of AP over (distance, camera MTF50), one panel per condition.
+
+    ``table``: the sweep table (columns ``condition, mtf50_cy_per_mm, distance_m, ap``).
+    ``mark_mtf50`` draws the dashed OD50 guide at that MTF50 (the paper uses 100 cy/mm).
+    """
+    _require(table, ("condition", "mtf50_cy_per_mm", "distance_m", "ap"))
+    conditions = list(conditions) if conditions is not None else list(dict.fromkeys(table["condition"]))
+    fig, axes = plt.subplots(1, len(conditions), figsize=(5.2 * len(conditions), 4.2), squeeze=False,
+                             constrained_layout=True)
+    filled = None
+    for ax, condition in zip(axes[0], conditions):
+        part = table[table["condition"] == condition]
+        if part.empty:
+            raise ValueError(f"condition {condition!r} is not in the table (has: {', '.join(map(str, table['condition'].unique()))})")
+        gx, gy, gz = interpolate_map(part["distance_m"], part["mtf50_cy_per_mm"], part["ap"])
+        filled = _draw_map(ax, gx, gy, gz, part["distance_m"], part["mtf50_cy_per_mm"])
+        if mark_mtf50 is not None and _mark_od50(ax, gx, gy, gz, mark_mtf50) is not None:
+            ax.legend(loc="upper right", fontsize=7)
+        ax.set(title=f"{condition}", xlabel="distance (m)", ylabel="MTF50 (cycles/mm)")
+    fig.colorbar(filled, ax=axes[0].tolist(), label="AP (COCO @[.5:.95], car)")
+    if title:
+        fig.suptitle(title)
+    if out is not None:
+        save_figure(fig, out)
+    return fig
+
+
+def spm_illuminance(table: pd.DataFrame, out=None, *, title: str | None = None):
+    """SPM of AP over (distance, scene illuminance) for one camera (paper Fig. 8).
+
+    ``table``: columns ``illuminance_lux`` (> 0; log axis), ``distance_m``, ``ap``; an
+    illuminance sweep of one camera (a ``camera`` column, if present, must hold one value).
+    """
+    _require(table, ("illuminance_lux", "distance_m", "ap"))
+    if "camera" in table and table["camera"].nunique() > 1:
+        raise ValueError(f"spm_illuminance takes one camera, got {sorted(table['camera'].unique())}")
+    gy, gx, gz = interpolate_map(table["illuminance_lux"], table["distance_m"], table["ap"], log_x=True)
+    fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
+    filled = _draw_map(ax, gx, gy, gz.T, table["distance_m"], table["illuminance_lux"])
+    ax.set_yscale("log")
+    ax.set(xlabel="distance (m)", ylabel="scene illuminance (lux)",
+           title=title or (f"{table['camera'].iloc[0]}" if "camera" in table else "AP vs illuminance"))
+    fig.colorbar(filled, ax=ax, label="AP (COCO @[.5:.95], car)")
+    if out is not None:
+        save_figure(fig, out)
+    return fig
+
+
+def fit_line(x, y) -> tuple[float, float]:
+    """(slope, intercept) of the least-squares line through the finite points."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    if ok.sum() < 2 or np.unique(x[ok]).size < 2:
+        return float("nan"), float("nan")
+    slope, intercept = np.polyfit(x[ok], y[ok], 1)
+    return float(slope), float(intercept)
+
+
+def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title: str | None = None):
+    """OD50 ± SD (bootstrap over environments) against MTF50, per condition, with a fitted
+    line whose slope (m per cycle/mm) is in the legend (paper Fig. 7A).
+
+    ``od50_table``: columns ``condition, mtf50_cy_per_mm, od50_m, sd_m`` (``od50.csv``).
+    Infinite OD50s (AP never falls to 0.5) are left out of the plot and the fit.
+    """
+    _require(od50_table, ("condition", "mtf50_cy_per_mm", "od50_m", "sd_m"))
+    conditions = list(conditions) if conditions is not None else list(dict.fromkeys(od50_table["condition"]))
+    fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
+    for k, condition in enumerate(conditions):
+        part = od50_table[od50_table["condition"] == condition]
+        part = part[np.isfinite(part["od50_m"].astype(float))]
+        colour = CONDITION_COLOURS.get(condition, f"C{k}")
+        slope, intercept = fit_line(part["mtf50_cy_per_mm"], part["od50_m"])
+        label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}"
+        ax.errorbar(part["mtf50_cy_per_mm"], part["od50_m"], yerr=part["sd_m"].fillna(0.0), fmt="o", color=colour,
+                    capsize=3, label=label)
+        if np.isfinite(slope):
+            xs = np.linspace(part["mtf50_cy_per_mm"].min(), part["mtf50_cy_per_mm"].max(), 2)
+            ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
+    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", title=title or "OD50 vs MTF50 (± bootstrap SD)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    if out is not None:
+        save_figure(fig, out)
+    return fig
+
+
+def _require(table: pd.DataFrame, columns) -> None:
+    missing = [c for c in columns if c not in table.columns]
+    if missing:
+        raise ValueError(f"table lacks column(s) {missing} (has: {list(table.columns)})")
+    if table.empty:
+        raise ValueError("table is empty")

@@ -1,0 +1,243 @@
+"""Every camera × condition on one collection: a tidy AP table and OD50 ± SD per run.
+
+Each (camera, condition) pair is one :func:`benchmark.run.run_camera` call in
+``out_dir/runs/<camera>-<condition>/``. Runs are cached: a run folder whose
+``results.json`` carries the same key — camera spec sha256, condition, detector sha256
+and input size, collection manifest sha256, seed — is reused, not recomputed.
+``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
+only its missing (or stale) runs.
+
+Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
+
+- ``sweep.csv`` / ``sweep.json``: one row per camera × condition × distance with
+  ``camera, pixel_um, f_number, mtf50_cy_per_mm, mtf50_source, condition, distance_m,
+  ap, ap50, n_images``;
+- ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
+  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`).
+
+MTF50 comes from ``mtf_source``: ``measured`` (ISO 12233 slanted edge through the camera,
+:func:`benchmark.mtf.measure_mtf50`), ``analytic`` (diffraction × pixel aperture) or
+``published`` (the paper's MTF50 group of a registry camera).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Callable, Iterable
+
+import numpy as np
+import pandas as pd
+
+SWEEP_FORMAT = "metricscenes-sweep/1"
+MTF_SOURCES = ("measured", "analytic", "published")
+TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
+                 "distance_m", "ap", "ap50", "n_images"]
+OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
+                "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite"]
+
+Progress = Callable[[int, int, str], None]
+
+
+def run_name(camera_name: str, condition: str) -> str:
+    """Folder name of one run under ``out_dir/runs``."""
+    return f"{camera_name}-{condition}"
+
+
+def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
+    """What makes two runs interchangeable (the cache key)."""
+    return {"camera_spec_sha256": camera.sha256(), "condition": condition,
+            "model_sha256": detector.sha256, "input_size": str(detector.input_size),
+            "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
+
+
+def results_key(results: dict) -> dict:
+    """The cache key recorded in a ``results.json``."""
+    return {"camera_spec_sha256": results["camera"]["spec_sha256"], "condition": results["condition"],
+            "model_sha256": results["detector"]["sha256"], "input_size": str(results["detector"]["input_size"]),
+            "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
+
+
+def cached_results(run_dir: Path, key: dict) -> dict | None:
+    """The results of ``run_dir`` if they are complete and carry ``key``, else None."""
+    try:
+        results = json.loads((Path(run_dir) / "results.json").read_text())
+        if results_key(results) != key:
+            return None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None  # missing, half-written or foreign: redo
+    if not all((Path(run_dir) / name).is_file() for name in ("detections.json", "groundtruth.json")):
+        return None
+    return results
+
+
+def camera_mtf50(camera, source: str = "measured") -> tuple[float, str]:
+    """(MTF50 in cycles/mm on the sensor, the source actually used).
+
+    ``measured`` and ``analytic`` fall back to the next source (analytic, then
+    published) when :mod:`benchmark.mtf` is unavailable or fails.
+    """
+    if source not in MTF_SOURCES:
+        raise ValueError(f"mtf_source must be one of {MTF_SOURCES}, got {source!r}")
+    for candidate in MTF_SOURCES[MTF_SOURCES.index(source):]:
+        try:
+            if candidate == "measured":
+                from benchmark.mtf import measure_mtf50
+
+                value = measure_mtf50(camera)["mtf50_cy_per_mm"]
+            elif candidate == "analytic":
+                from benchmark.mtf import mtf50_analytic_cy_per_mm
+
+                value = mtf50_analytic_cy_per_mm(camera.pixel_um, camera.f_number, sensor_spec=camera.sensor)
+            else:
+                value = camera.mtf50_group_cy_per_mm
+        except (ImportError, ValueError, RuntimeError):
+            continue
+        if value is not None and np.isfinite(value):
+            return float(value), candidate
+    return float("nan"), "none"
+
+
+def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
+    """Bootstrap OD50 of one run folder, cached in ``od50.json`` next to its detections."""
+    from benchmark.scoring import bootstrap_od50
+
+    run_dir = Path(run_dir)
+    results = json.loads((run_dir / "results.json").read_text())
+    key = {"detections_sha256": results.get("detections_sha256"), "n_resamples": int(n_resamples), "seed": int(seed)}
+    cache = run_dir / "od50.json"
+    try:
+        stored = json.loads(cache.read_text())
+        if stored.get("key") == key:
+            return stored["od50"]
+    except (OSError, ValueError, AttributeError):
+        pass
+    gt = json.loads((run_dir / "groundtruth.json").read_text())
+    dets = json.loads((run_dir / "detections.json").read_text())
+    out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=results.get("scoring_backend", "faster-coco-eval"))
+    out = {**out, "ci95_m": list(out["ci95_m"])}
+    _write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
+    return _json_safe(out)
+
+
+def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
+          n_resamples: int = 1000, progress: Progress | None = None, mtf_source: str = "measured",
+          backend: str = "faster-coco-eval", save_images: bool = True) -> pd.DataFrame:
+    """Run every camera × condition (reusing cached runs); write and return the AP table.
+
+    Args:
+        collection: a :class:`metricscenes.store.Collection` or its folder.
+        cameras: :class:`CameraSpec` s or names/paths accepted by ``load_camera``.
+        conditions: condition names of the collection (``day``, ``night``, ...).
+        detector: a loaded detector (:func:`benchmark.detectors.load_detector`).
+        out_dir: sweep folder; runs go to ``out_dir/runs/<camera>-<condition>``.
+        seed: sensor-noise seed of every run and the bootstrap seed.
+        n_resamples: bootstrap resamples of OD50 (over environments).
+        progress: optional ``(done, total, label)`` callable; units are scenes, a cached
+            run advances by all its scenes at once.
+        mtf_source: ``measured`` | ``analytic`` | ``published`` (see :func:`camera_mtf50`).
+
+    Returns:
+        The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
+    """
+    from benchmark import run as run_module
+    from benchmark.cameras import load_camera
+    from metricscenes.store import Collection
+
+    if mtf_source not in MTF_SOURCES:
+        raise ValueError(f"mtf_source must be one of {MTF_SOURCES}, got {mtf_source!r}")
+    if isinstance(collection, (str, os.PathLike)):
+        collection = Collection.open(collection)
+    cameras = [c if hasattr(c, "sha256") else load_camera(c) for c in cameras]
+    conditions = list(conditions)
+    if not cameras or not conditions:
+        raise ValueError("sweep needs at least one camera and one condition")
+    for condition in conditions:
+        if condition not in collection.conditions:
+            raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(collection.conditions)})")
+    names = [c.name for c in cameras]
+    if len(set(names)) != len(names):
+        raise ValueError(f"camera names must be unique, got {names}")
+    out_dir = Path(out_dir)
+    (out_dir / "runs").mkdir(parents=True, exist_ok=True)
+
+    n_scenes = len(collection.scenes())
+    total, done = n_scenes * len(cameras) * len(conditions), 0
+    rows, od50_rows, runs = [], [], []
+    for camera in cameras:
+        mtf50, source = camera_mtf50(camera, mtf_source)
+        ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
+                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
+        for condition in conditions:
+            label = f"{camera.name} · {condition}"
+            run_dir = out_dir / "runs" / run_name(camera.name, condition)
+            results = cached_results(run_dir, run_key(camera, condition, detector, collection, seed))
+            reused = results is not None
+            if results is None:
+                base = done
+                results = run_module.run_camera(
+                    collection, camera, condition, detector, run_dir, seed=seed, save_images=save_images,
+                    backend=backend,
+                    progress=(lambda d, t, base=base, label=label: progress(base + d, total, label)) if progress else None)
+            done += n_scenes
+            if progress:
+                progress(done, total, label)
+            runs.append({"camera": camera.name, "condition": condition, "path": str(run_dir.relative_to(out_dir)),
+                         "reused": reused})
+            for r in results["per_distance"]:
+                rows.append({**ident, "condition": condition, "distance_m": r["distance_m"], "ap": r["ap"],
+                             "ap50": r["ap50"], "n_images": r["n_images"]})
+            boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
+            lo, hi = boot["ci95_m"]
+            od50_rows.append({**ident, "condition": condition, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
+                              "ci95_lo_m": _num(lo), "ci95_hi_m": _num(hi), "n_resamples": boot["n_resamples"],
+                              "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"]})
+
+    table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
+    od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
+    _write_atomic(out_dir / "sweep.csv", table.to_csv(index=False))
+    _write_atomic(out_dir / "od50.csv", od50_table.to_csv(index=False))
+    meta = {
+        "format": SWEEP_FORMAT,
+        "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
+        "detector": {"name": detector.name, "sha256": detector.sha256, "input_size": str(detector.input_size)},
+        "seed": int(seed), "n_resamples": int(n_resamples), "mtf_source": mtf_source, "scoring_backend": backend,
+        "cameras": names, "conditions": conditions, "runs": runs,
+        "table": _json_safe(table.to_dict(orient="records")),
+        "od50": _json_safe(od50_table.to_dict(orient="records")),
+    }
+    _write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
+    return table
+
+
+def load_sweep(out_dir) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(AP table, OD50 table) of a sweep folder."""
+    out_dir = Path(out_dir)
+    return pd.read_csv(out_dir / "sweep.csv"), pd.read_csv(out_dir / "od50.csv")
+
+
+def _num(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
+def _json_safe(value):
+    """Strict JSON: NaN becomes None, ±inf the strings "inf"/"-inf" (``float()`` reads them back)."""
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        if math.isnan(value):
+            return None
+        return float(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+    tmp.write_text(text)
+    os.replace(tmp, path)

@@ -1,0 +1,242 @@
+"""The procedural car library: 50 seeded cars over 7 body styles, as Mitsuba scene parts.
+
+Each car is a lofted, rounded, tapered body (``car_body``) with a dark-glass greenhouse,
+wheel arches, four wheels showing under the body, head and tail lamps, licence plates,
+grille, intakes and mirrors — the features that made procedural cars recognisable to a
+COCO YOLOv5 in the feasibility study (``reference/car-detectability.md``).
+
+Car frame: origin on the ground under the car's centre, x toward the front, y left, z up.
+``car_parts(spec, (x, y), yaw)`` places it in the world (yaw = 0: front along +x, away from
+the camera at the origin; yaw = pi: oncoming).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from metricscenes.assets import lamps as lamp_photometry
+from metricscenes.assets import materials
+from metricscenes.assets.car_body import BodyShape
+from metricscenes.assets.car_parts import (
+    LampRect, MeshPart, conformal_patch, finish, lamp_rect, mirror_meshes, normals_for,
+    split_greenhouse, wheel_meshes,
+)
+from metricscenes.assets.car_styles import PAINT_WEIGHTS, STYLE_SCHEDULE, STYLES
+from metricscenes.assets.parts import Lamp, SceneParts, mesh_shape
+
+CAR_IDS: list[int] = list(range(50))
+BODY_STYLES: tuple[str, ...] = tuple(STYLES)
+LIBRARY_SEED = 20230115  # fixed base seed of the library (any change re-draws every car)
+LIGHT_MODES = ("auto", "on", "brake", "off")
+
+
+@dataclass(frozen=True)
+class CarSpec:
+    """Main parameters of one library car (metres)."""
+
+    car_id: int
+    body_style: str
+    length_m: float
+    width_m: float
+    height_m: float
+    wheelbase_m: float
+    paint: str
+    tyre_radius_m: float
+    tyre_width_m: float
+    track_m: float
+    front_overhang_m: float
+    headlamp_kind: str  # 'led' or 'halogen'
+    belt_scale: float  # multiplies the lower-body profile heights (0.97-1.03)
+    greenhouse_shift: float  # shift of the greenhouse along u (-0.015..0.015)
+
+
+def car_spec(car_id: int) -> CarSpec:
+    """Deterministic spec of library car ``car_id`` (0..49), drawn from a seeded Generator."""
+    if int(car_id) != car_id or not 0 <= car_id < len(CAR_IDS):
+        raise ValueError(f"car_id must be an integer in 0..{len(CAR_IDS) - 1}, got {car_id!r}")
+    rng = np.random.default_rng([LIBRARY_SEED, int(car_id)])
+    style = STYLE_SCHEDULE[car_id % len(STYLE_SCHEDULE)]
+    st = STYLES[style]
+
+    def draw(key):
+        lo, hi = st[key]
+        return float(rng.uniform(lo, hi))
+
+    length, width, height = draw("length"), draw("width"), draw("height")
+    wheelbase = min(draw("wheelbase"), length - 1.25)
+    tyre_r, tyre_w = draw("tyre_radius"), draw("tyre_width")
+    names = list(PAINT_WEIGHTS)
+    p = np.array([PAINT_WEIGHTS[n] for n in names])
+    paint = names[int(rng.choice(len(names), p=p / p.sum()))]
+    return CarSpec(
+        car_id=int(car_id), body_style=style, length_m=round(length, 3), width_m=round(width, 3),
+        height_m=round(height, 3), wheelbase_m=round(wheelbase, 3), paint=paint,
+        tyre_radius_m=round(tyre_r, 3), tyre_width_m=round(tyre_w, 3),
+        track_m=round(width - tyre_w - float(rng.uniform(0.07, 0.11)), 3),
+        front_overhang_m=round((length - wheelbase) * st["front_overhang_frac"], 3),
+        headlamp_kind="led" if rng.uniform() < 0.7 else "halogen",
+        belt_scale=round(float(rng.uniform(0.97, 1.03)), 4),
+        greenhouse_shift=round(float(rng.uniform(-0.015, 0.015)), 4),
+    )
+
+
+def car_library() -> list[CarSpec]:
+    """All library cars, in id order."""
+    return [car_spec(i) for i in CAR_IDS]
+
+
+def body_shape(spec: CarSpec) -> BodyShape:
+    """The lofted-body description of a spec."""
+    st = STYLES[spec.body_style]
+    top = tuple((u, z * spec.belt_scale) for u, z in st["top"])
+    gh = tuple(float(np.clip(u + spec.greenhouse_shift, 0.005, 0.99)) for u in st["greenhouse"])
+    return BodyShape(spec.length_m, spec.width_m, spec.height_m, top, tuple(st["bot"]), gh,
+                     tumblehome=st["tumblehome"])
+
+
+@dataclass(frozen=True)
+class CarGeometry:
+    meshes: tuple[MeshPart, ...]
+    lamps: tuple[LampRect, ...]
+
+
+@lru_cache(maxsize=64)
+def car_geometry(spec: CarSpec) -> CarGeometry:
+    """All meshes and lamp rectangles of a car in its own frame (cached per spec)."""
+    body = body_shape(spec)
+    pre = f"car_{spec.car_id:02d}"
+    x_front_axle = 0.5 * spec.length_m - spec.front_overhang_m
+    wheels_x = (x_front_axle, x_front_axle - spec.wheelbase_m)
+    parts: list[MeshPart] = []
+    v, f = body.lower_body(wheels_x, spec.tyre_radius_m, spec.track_m, spec.tyre_width_m)
+    parts.append(MeshPart(f"{pre}_body", v, f, "paint"))
+    gv, gf, s_v, env, h_v = body.greenhouse()
+    glass_f, paint_f = split_greenhouse(body, gv, gf, s_v, env, h_v)
+    parts += [MeshPart(f"{pre}_glass", gv, glass_f, "car_glass"), MeshPart(f"{pre}_roof", gv, paint_f, "paint")]
+    for i, xw in enumerate(wheels_x):
+        for side, sgn in (("l", 1.0), ("r", -1.0)):
+            parts += wheel_meshes(f"{pre}_wheel{i}{side}", xw, sgn * 0.5 * spec.track_m,
+                                  spec.tyre_radius_m, spec.tyre_width_m, sgn)
+    parts += mirror_meshes(body, pre)
+    lamps = _front_and_rear(body, spec, pre, parts)
+    return CarGeometry(tuple(finish(parts)), tuple(lamps))
+
+
+def _front_and_rear(body: BodyShape, spec: CarSpec, pre: str, parts: list[MeshPart]) -> list[LampRect]:
+    """Grille, intakes, plates, bumper trim and the lamp rectangles (appends to ``parts``)."""
+    style, W = spec.body_style, spec.width_m
+    tall = style in ("suv", "pickup", "van")
+    lamps: list[LampRect] = []
+    # front face: from the bumper underside to the nose top
+    zb, zt = float(body.z_bot(0.99)), float(body.z_top(0.975))
+    span = zt - zb
+    lw, lh = 0.15 * W / 1.8 + 0.02, (0.05 if not tall else 0.06)
+    ly, lz = 0.5 * W - 0.09 - lw, zb + 0.80 * span
+    for side, sgn in (("l", 1), ("r", -1)):
+        hv, hf = conformal_patch(body, True, sgn * ly, lz, lw + 0.02, lh + 0.015, 0.004, 8.0)
+        parts.append(MeshPart(f"{pre}_headhousing_{side}", hv, hf, "trim_black", smooth=False))
+        lamps.append(lamp_rect(body, f"{pre}_headlamp_{side}", "head", True, sgn * ly, lz, (lw, lh), "lens_clear"))
+    gy = ly - lw - 0.04
+    gz = zb + (0.56 if tall else 0.60) * span
+    gh = (0.16 if tall else 0.11) * span / 0.45
+    gv, gf = conformal_patch(body, True, 0.0, gz, gy, gh, 0.004, 5.0)
+    parts.append(MeshPart(f"{pre}_grille", gv, gf, "trim_black", smooth=False))
+    iv, if_ = conformal_patch(body, True, 0.0, zb + 0.14 * span, 0.33 * W, 0.07 * span / 0.45 + 0.02, 0.004, 5.0)
+    parts.append(MeshPart(f"{pre}_intake", iv, if_, "trim_black", smooth=False))
+    parts += _plate(body, pre + "_plate_f", True, zb + 0.33 * span)
+    # rear face
+    zb, zt = float(body.z_bot(0.01)), float(body.z_top(0.03))
+    span = zt - zb
+    if style in ("pickup", "van"):
+        tw, th = 0.07, 0.20 * span / 0.6
+        ty, tz = 0.5 * W - 0.06 - tw, zb + 0.62 * span
+    else:
+        tw, th = 0.16 * W / 1.8 + 0.02, 0.06
+        ty, tz = 0.5 * W - 0.07 - tw, zb + 0.76 * span
+    for side, sgn in (("l", 1), ("r", -1)):
+        hv, hf = conformal_patch(body, False, sgn * ty, tz, tw + 0.015, th + 0.015, 0.004, 8.0)
+        parts.append(MeshPart(f"{pre}_tailhousing_{side}", hv, hf, "trim_black", smooth=False))
+        lamps.append(lamp_rect(body, f"{pre}_taillamp_{side}", "tail", False, sgn * ty, tz, (tw, th), "lens_red"))
+    bv, bf = conformal_patch(body, False, 0.0, zb + 0.10 * span, 0.40 * W, 0.08 * span, 0.004, 5.0)
+    parts.append(MeshPart(f"{pre}_rearbumper", bv, bf, "trim_black", smooth=False))
+    parts += _plate(body, pre + "_plate_r", False, zb + 0.45 * span)
+    if "bed" in STYLES[style]:
+        u0, u1 = STYLES[style]["bed"]
+        parts.append(_bed_floor(body, pre, u0, u1))
+    return lamps
+
+
+def _plate(body: BodyShape, key: str, front: bool, z: float) -> list[MeshPart]:
+    """EU plate 520 x 110 mm of retroreflective white sheeting (characters are sub-pixel at 25 m)."""
+    pv, pf = conformal_patch(body, front, 0.0, z, 0.26, 0.055, 0.006, 12.0, n=(8, 4))
+    return [MeshPart(key, pv, pf, "plate_white", smooth=False)]
+
+
+def _bed_floor(body: BodyShape, pre: str, u0: float, u1: float) -> MeshPart:
+    """Dark bed liner seen from above on a pickup's rear deck."""
+    x0, x1 = body.x_of_u(u0), body.x_of_u(u1)
+    w = 0.5 * body.width_m - 0.07
+    z = float(body.z_top(0.5 * (u0 + u1))) + 0.004
+    v = np.array([[x0, -w, z], [x1, -w, z], [x1, w, z], [x0, w, z]])
+    return MeshPart(f"{pre}_bed", v, np.array([[0, 1, 2], [0, 2, 3]]), "trim_black", smooth=False)
+
+
+def _world(position_m, yaw_rad) -> np.ndarray:
+    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    m = np.eye(4)
+    m[:2, :2] = [[c, -s], [s, c]]
+    m[0, 3], m[1, 3] = float(position_m[0]), float(position_m[1])
+    return m
+
+
+def car_vertices_world(spec: CarSpec, position_m, yaw_rad) -> np.ndarray:
+    """(N, 3) every mesh vertex and lamp corner of the car in world metres (for GT boxes)."""
+    geo = car_geometry(spec)
+    m = _world(position_m, yaw_rad)
+    v = np.concatenate([p.vertices for p in geo.meshes] + [lamp.corners() for lamp in geo.lamps])
+    return v @ m[:3, :3].T + m[:3, 3]
+
+
+def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, lights: str = "auto") -> SceneParts:
+    """Mitsuba shapes and lamps (light group 'car_lights') of a car placed in the world.
+
+    ``lights``: 'auto'/'on' (low-beam head lamps with a road-lighting spot each, tail lamps),
+    'brake' (as 'on' with stop-lamp intensity at the rear), 'off' (no emitters; lenses stay).
+    The variant (``scalar_spectral``) must be set by the caller.
+    """
+    import mitsuba as mi
+
+    if lights not in LIGHT_MODES:
+        raise ValueError(f"lights must be one of {LIGHT_MODES}, got {lights!r}")
+    geo = car_geometry(spec)
+    m = _world(position_m, yaw_rad)
+    rot = m[:3, :3]
+    shapes: dict[str, object] = {}
+    paint = materials.car_paint_bsdf(spec.paint)
+    for p in geo.meshes:
+        bsdf = paint if p.material == "paint" else materials.bsdf(p.material)
+        n = normals_for(p)
+        shapes[p.key] = mesh_shape(p.key, p.vertices @ rot.T + m[:3, 3], p.faces, bsdf,
+                                   None if n is None else n @ rot.T)
+    lamps: list[Lamp] = []
+    for lr in geo.lamps:
+        shape = {"type": "rectangle", "to_world": mi.ScalarTransform4f((m @ lr.matrix()).tolist()),
+                 "bsdf": materials.bsdf(lr.material)}
+        if lights == "off":
+            shapes[lr.key] = shape
+            continue
+        if lr.role == "head":
+            wl, rad = lamp_photometry.headlamp(spec.headlamp_kind, lens_area_m2=lr.area_m2)
+        else:
+            wl, rad = lamp_photometry.tail_lamp(brake=lights == "brake", lens_area_m2=lr.area_m2)
+        lamps.append(Lamp(lr.key, "car_lights", shape, lamp_photometry.area_emitter(wl, rad)))
+        if lr.role == "head":
+            origin = lr.centre + 0.05 * lr.normal
+            target = origin + np.array([40.0, 0.0, -origin[2]])
+            wl_b, inten = lamp_photometry.headlamp_beam(spec.headlamp_kind)
+            lamps.append(Lamp(lr.key + "_beam", "car_lights", None, lamp_photometry.spot_emitter(
+                wl_b, inten, rot @ origin + m[:3, 3], rot @ target + m[:3, 3], cutoff_deg=35.0, beam_width_deg=12.0)))
+    return SceneParts(shapes=shapes, lamps=tuple(lamps))

@@ -1,0 +1,302 @@
+"""Leaderboard validation: every kind of bad submission is refused with a one-line reason,
+exit code 2, and the leaderboard folder left byte-identical."""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from benchmark.cli_leaderboard import register
+from benchmark.leaderboard import (
+    build_submission,
+    check_submission_file,
+    dumps_submission,
+    find_runs,
+    load_protocols,
+    tree_sha256,
+    write_submission,
+)
+from benchmark.leaderboard.synthetic import write_synthetic_run
+from benchmark.scoring import od50
+
+REPO = Path(__file__).resolve().parents[1]
+CREATED = "2025-01-02T03:04:05Z"
+PROTOCOLS = """protocols:
+  smoke:
+    description: smoke
+    manifests_sha256: [{sha}]
+    distances_m: [25, 50, 75, 100, 150, 200]
+    conditions: [day, night]
+    required_conditions: [day]
+"""
+
+
+@pytest.fixture(scope="module")
+def app():
+    app = typer.Typer()
+    register(app)
+
+    @app.callback()  # keep the commands subcommands, as in the lead's CLI
+    def main():
+        pass
+
+    return app
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory):
+    """A leaderboard holding one submission, and a valid second submission (with its run) outside it."""
+    from benchmark.cameras import load_camera
+    from metricscenes.manifest import load_manifest
+
+    root = tmp_path_factory.mktemp("lb")
+    manifest = load_manifest(REPO / "manifests" / "smoke.yaml")
+    leaderboard = root / "leaderboard"
+    (leaderboard / "submissions").mkdir(parents=True)
+    # this leaderboard accepts the smoke manifest as it is now (the packaged list is checked in test_leaderboard_submit)
+    (leaderboard / "protocols.yaml").write_text(PROTOCOLS.format(sha=manifest.sha256()))
+    protocols = load_protocols(leaderboard)
+    for cam, half_range in (("cam03", 70.0), ("cam07", 110.0)):
+        for cond in ("day", "night"):
+            write_synthetic_run(root / cam / cond, load_camera(cam), cond, manifest=manifest, half_range_m=half_range,
+                                seed={"day": 1, "night": 2}[cond])  # fmt: skip
+    existing = build_submission(find_runs(root / "cam03" / "day"), name="existing", submitter="a", created_at=CREATED,
+                                n_resamples=20, measure_mtf=False, protocols=protocols)  # fmt: skip
+    write_submission(existing, leaderboard)
+    runs = find_runs(root / "cam07" / "day") + find_runs(root / "cam07" / "night")
+    good = build_submission(runs, name="good", submitter="b", created_at=CREATED, n_resamples=20, measure_mtf=False, protocols=protocols)
+    return {"root": root, "leaderboard": leaderboard, "good": good, "existing": existing}
+
+
+def _fix_od50(sub: dict) -> dict:
+    """Make every condition's OD50 follow from its (edited) AP curve again."""
+    for cond in sub["conditions"].values():
+        rows = sorted(cond["per_distance"], key=lambda r: r["distance_m"])
+        value = od50([r["distance_m"] for r in rows], [r["ap"] for r in rows])
+        cond["od50_m"] = round(value, 3) if math.isfinite(value) else None
+    return sub
+
+
+def _rehash(sub: dict) -> dict:
+    sub["camera"]["spec_sha256"] = hashlib.sha256(
+        json.dumps(sub["camera"]["spec"], sort_keys=True, separators=(",", ":")).encode()
+    ).hexdigest()
+    return sub
+
+
+def _edit(fn):
+    def make(good: dict) -> bytes:
+        sub = copy.deepcopy(good)
+        fn(sub)  # edits in place
+        return dumps_submission(sub).encode()
+
+    return make
+
+
+def _text(fn):
+    return lambda good: fn(dumps_submission(good)).encode()
+
+
+def _set_ap(value):
+    def fn(sub):
+        sub["conditions"]["day"]["per_distance"][1]["ap"] = value
+
+    return fn
+
+
+def _drop_distance(sub):
+    sub["conditions"]["day"]["per_distance"].pop(4)  # 150 m
+    _fix_od50(sub)
+
+
+def _extra_distance(sub):
+    sub["conditions"]["day"]["per_distance"].append({"distance_m": 300.0, "ap": 0.0, "ap50": 0.0, "n_images": 4})
+    _fix_od50(sub)
+
+
+def _repeat_distance(sub):
+    rows = sub["conditions"]["day"]["per_distance"]
+    rows[5] = dict(rows[4])
+
+
+def _pixel(sub):
+    sub["camera"]["spec"]["sensor"]["pixel_um"] = 1.0
+
+
+def _bad_spec_rehashed(sub):
+    sub["camera"]["spec"]["sensor"]["pixel_um"] = 100.0
+    _rehash(sub)
+
+
+def _derived_width(sub):
+    sub["camera"]["spec"]["sensor"]["width_px"] = 4000
+    _rehash(sub)
+
+
+def _only_night(sub):
+    del sub["conditions"]["day"]
+
+
+def _fog(sub):
+    sub["conditions"]["fog"] = copy.deepcopy(sub["conditions"]["night"])
+
+
+def _od50_off(sub):
+    cond = sub["conditions"]["day"]
+    cond["od50_m"] = 12.0 if cond["od50_m"] != 12.0 else 13.0
+
+
+# (id, make bytes from the good submission, file name, expected piece of the message)
+BAD = [
+    ("not-json", lambda good: b"{this is not json", "good.json", "invalid JSON at line 1"),
+    ("truncated", lambda good: dumps_submission(good).encode()[:700], "good.json", "invalid JSON"),
+    ("empty", lambda good: b"", "good.json", "invalid JSON at line 1 column 1"),
+    ("not-utf8", lambda good: b'{"name": "\xff"}', "good.json", "not UTF-8"),
+    ("nan-literal", _text(lambda t: t.replace('"od50_sd_m": ', '"od50_sd_m": NaN, "x": ', 1)), "good.json", "non-standard literal NaN"),
+    ("duplicate-key", _text(lambda t: t.replace('"submitter": "b"', '"submitter": "b", "submitter": "c"')), "good.json", "duplicate key 'submitter'"),
+    ("top-level-array", lambda good: b"[1, 2]", "good.json", "schema: (top level): [1, 2] is not of type 'object'"),
+    ("wrong-format", _edit(lambda s: s.update(format="metricscenes-submission/0")), "good.json", "schema: format:"),
+    ("missing-field", _edit(lambda s: s.pop("submitter")), "good.json", "'submitter' is a required property"),
+    ("unknown-field", _edit(lambda s: s.update(secret=1)), "good.json", "Additional properties are not allowed ('secret'"),
+    ("ap-as-string", _edit(_set_ap("0.5")), "good.json", "schema: conditions.day.per_distance[1].ap: '0.5' is not of type 'number'"),
+    ("n-images-float", _edit(lambda s: s["conditions"]["day"]["per_distance"][0].update(n_images=2.5)), "good.json",
+     "per_distance[0].n_images: 2.5 is not of type 'integer'"),
+    ("ap-above-1", _edit(_set_ap(1.5)), "good.json", "conditions.day.per_distance[1].ap: 1.5 is greater than the maximum of 1"),
+    ("ap-below-0", _edit(_set_ap(-0.01)), "good.json", "conditions.day.per_distance[1].ap: -0.01 is less than the minimum of 0"),
+    ("bad-sha-format", _edit(lambda s: s["detector"].update(sha256="XYZ")), "good.json", "detector.sha256: 'XYZ' does not match"),
+    ("bad-date", _edit(lambda s: s.update(created_at="2025-13-01T00:00:00Z")), "good.json", "created_at '2025-13-01T00:00:00Z' is not a valid UTC date"),
+    ("missing-distance", _edit(_drop_distance), "good.json", "conditions.day.per_distance: missing distance(s) 150 m"),
+    ("extra-distance", _edit(_extra_distance), "good.json", "distance 300 m is not one of protocol 'smoke'"),
+    ("repeated-distance", _edit(_repeat_distance), "good.json", "distance 150 m appears 2 times"),
+    ("missing-day", _edit(_only_night), "good.json", "missing required condition 'day'"),
+    ("unknown-condition", _edit(_fog), "good.json", "conditions.fog: not a condition of protocol 'smoke'"),
+    ("od50-inconsistent", _edit(_od50_off), "good.json", "conditions.day.od50_m = 1"),
+    ("spec-edited", _edit(_pixel), "good.json", "camera.spec_sha256"),
+    ("spec-hash-edited", _edit(lambda s: s["camera"].update(spec_sha256="0" * 64)), "good.json", "does not match the spec's content"),
+    ("spec-invalid", _edit(_bad_spec_rehashed), "good.json", "field 'sensor.pixel_um' = 100.0"),
+    ("spec-derived-edited", _edit(_derived_width), "good.json", "not a resolved camera spec"),
+    ("isp-differs", _edit(lambda s: s["isp"].update(demosaic="bilinear")), "good.json", "isp differs from camera.spec.isp"),
+    ("unknown-protocol", _edit(lambda s: s["collection"].update(protocol="homebrew")), "good.json", "protocol 'homebrew' is not accepted"),
+    ("manifest-not-accepted", _edit(lambda s: s["collection"].update(manifest_sha256="ab" * 32)), "good.json",
+     "collection.manifest_sha256 abababababab... is not an accepted manifest of protocol 'smoke'"),
+    ("name-mismatch", lambda good: dumps_submission(good).encode(), "other.json", "file name must be <name>.json"),
+    ("unsafe-file-name", lambda good: dumps_submission(good).encode(), "bad name.json", "unsafe submission name 'bad name'"),
+    ("unsafe-name-field", _edit(lambda s: s.update(name="../escape")), "good.json", "name is '../escape'"),
+    ("not-dot-json", lambda good: dumps_submission(good).encode(), "good.txt", "must end in .json"),
+    ("over-5-MB", lambda good: dumps_submission(good).encode() + b" " * (5 * 1024 * 1024), "good.json", "over the 5 MB limit"),
+    ("duplicate-name", _edit(lambda s: s.update(name="existing")), "existing.json", "duplicate name"),
+]  # fmt: skip
+
+
+def _invoke(app, args):
+    res = CliRunner().invoke(app, [str(a) for a in args])
+    stderr = getattr(res, "stderr", None) or res.output
+    return res, stderr
+
+
+@pytest.mark.parametrize("case", BAD, ids=[c[0] for c in BAD])
+def test_bad_submission_refused(app, world, tmp_path, case):
+    _, make, file_name, expected = case
+    path = tmp_path / file_name
+    path.write_bytes(make(world["good"]))
+    before = tree_sha256(world["leaderboard"])
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
+    assert res.exit_code == 2, res.output
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), stderr
+    assert expected in lines[0], lines[0]
+    assert tree_sha256(world["leaderboard"]) == before
+
+
+def test_good_submission_passes_and_touches_nothing(app, world, tmp_path):
+    path = tmp_path / "good.json"
+    path.write_text(dumps_submission(world["good"]))
+    before = tree_sha256(world["leaderboard"])
+    root = world["root"]
+    res, _ = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
+                           "--detections", root / "cam07" / "day" / "detections.json",
+                           "--groundtruth", root / "cam07" / "day" / "groundtruth.json"])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "ok: good.json (protocol smoke, conditions day, night; AP recomputed from 1 detections file(s))" in res.output
+    # (the synthetic runs draw a new ground truth per condition; real runs of one camera share it)
+    res, _ = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
+                           "--detections", root / "cam07" / "night" / "detections.json",
+                           "--groundtruth", root / "cam07" / "night" / "groundtruth.json"])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert tree_sha256(world["leaderboard"]) == before
+    # a file already in the leaderboard is not its own duplicate
+    check_submission_file(world["leaderboard"] / "submissions" / "existing.json", leaderboard_dir=world["leaderboard"])
+
+
+def test_content_duplicate_under_another_name(app, world, tmp_path):
+    sub = copy.deepcopy(world["existing"])
+    sub["name"] = "renamed"
+    path = tmp_path / "renamed.json"
+    path.write_text(dumps_submission(sub))
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
+    assert res.exit_code == 2 and "duplicate: existing.json has the same camera, detector, collection and detections" in stderr
+
+
+@pytest.mark.parametrize("what", ["ap", "ap50"])
+def test_ap_mismatch_with_detections(app, world, tmp_path, what):
+    sub = copy.deepcopy(world["good"])
+    row = sub["conditions"]["day"]["per_distance"][2]
+    row[what] = round(row[what] + 2e-6, 9) if row[what] < 0.5 else row[what] - 2e-6  # beyond the 1e-6 tolerance
+    _fix_od50(sub)
+    path = tmp_path / "good.json"
+    path.write_text(dumps_submission(sub))
+    day = world["root"] / "cam07" / "day"
+    before = tree_sha256(world["leaderboard"])
+    args = ["submit", "--check", path, "--leaderboard", world["leaderboard"]]
+    res, _ = _invoke(app, args)
+    assert res.exit_code == 0, res.output  # without the detections the edit cannot be seen
+    res, stderr = _invoke(app, [*args, "--detections", day / "detections.json", "--groundtruth", day / "groundtruth.json"])
+    assert res.exit_code == 2
+    assert f"conditions.day: {what.upper()} at 75 m is" in stderr and "recomputed from detections.json" in stderr, stderr
+    assert tree_sha256(world["leaderboard"]) == before
+
+
+def test_detections_of_another_system(app, world, tmp_path):
+    path = tmp_path / "good.json"
+    path.write_text(dumps_submission(world["good"]))
+    other = world["root"] / "cam03" / "day"
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
+                                "--detections", other / "detections.json", "--groundtruth", other / "groundtruth.json"])  # fmt: skip
+    assert res.exit_code == 2 and "is not the file any condition was computed from" in stderr
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"], "--detections", other / "detections.json"])
+    assert res.exit_code == 2 and "--detections needs --groundtruth" in stderr
+
+
+@pytest.mark.parametrize("name", ["../escape", "a/b", "a\\b", ".hidden", "sp ace", "naïve", ""])
+def test_unsafe_names_refused_when_building(app, world, name):
+    before = tree_sha256(world["leaderboard"])
+    res, stderr = _invoke(app, ["submit", world["root"] / "cam03" / "night", "--name", name, "--leaderboard", world["leaderboard"],
+                                "--n-resamples", "5", "--no-mtf"])  # fmt: skip
+    assert res.exit_code == 2
+    assert stderr.strip().startswith("error: unsafe submission name"), stderr
+    assert tree_sha256(world["leaderboard"]) == before
+
+
+def test_build_refuses_changed_run_files(app, world, tmp_path):
+    import shutil
+
+    run = tmp_path / "run"
+    shutil.copytree(world["root"] / "cam03" / "night", run)
+    before = tree_sha256(world["leaderboard"])
+    args = ["submit", run, "--name", "n1", "--leaderboard", world["leaderboard"], "--n-resamples", "5", "--no-mtf"]
+    results = json.loads((run / "results.json").read_text())
+    results["per_distance"][0]["ap"] = results["per_distance"][0]["ap"] / 2 + 0.01  # a results.json that lies
+    (run / "results.json").write_text(json.dumps(results))
+    res, stderr = _invoke(app, args)
+    assert res.exit_code == 2 and "recomputed from detections.json" in stderr, stderr
+    (run / "detections.json").write_text("[]")  # detections that are not the scored ones
+    res, stderr = _invoke(app, args)
+    assert res.exit_code == 2 and "sha256 differs from results.json's detections_sha256" in stderr, stderr
+    assert tree_sha256(world["leaderboard"]) == before

@@ -1,0 +1,230 @@
+"""benchmark.sweep: table shape, run cache, resume, OD50 table — with a fake run_camera.
+
+The fake writes what :func:`benchmark.run.run_camera` writes (results.json last,
+detections, scaled ground truth, images) from the seeded synthetic detector of
+``benchmark.scoring.synthetic``, whose range grows as the pixel shrinks and halves at
+night, so no rendering or detector is needed. ``tests/test_report_html.py`` reuses it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from benchmark import sweep as sweep_module
+from benchmark.cameras import load_camera
+from benchmark.scoring import ap_by_distance, bootstrap_od50
+from benchmark.scoring.synthetic import synthetic_collection
+
+N_ENV = 4
+
+
+@dataclass(frozen=True)
+class FakeScene:
+    scene_id: str
+    image_id: int
+    environment_id: int
+    distance_m: float
+
+
+class FakeCollection:
+    """Duck-typed :class:`metricscenes.store.Collection` over the synthetic ground truth."""
+
+    def __init__(self, root: Path, manifest_sha256: str = "f" * 64):
+        self.root, self.name, self.protocol, self.manifest_sha256 = Path(root), "fake", "fake", manifest_sha256
+        self.conditions = {"day": {"sky_day": 1.0}, "night": {"sky_night": 1.0}}
+        self._gt, _ = synthetic_collection(N_ENV, seed=1)
+
+    def scenes(self):
+        return [FakeScene(im["scene_id"], im["id"], im["environment_id"], im["distance_m"]) for im in self._gt["images"]]
+
+    def groundtruth(self):
+        return json.loads(json.dumps(self._gt))
+
+
+@dataclass
+class FakeDetector:
+    name: str = "fake-yolo"
+    family: str = "yolov5"
+    sha256: str = "d" * 64
+    input_size: str = "multiscale"
+
+
+def synthetic_detections(gt: dict, half_range_m: float, seed: int) -> list[dict]:
+    """A seeded fake detector: finds the car with probability 1 / (1 + (d / half_range)^4),
+    box jitter and score worsening with distance, plus one false positive per image."""
+    dets = []
+    for ann in gt["annotations"]:
+        im = next(i for i in gt["images"] if i["id"] == ann["image_id"])
+        rng = np.random.default_rng([seed, im["id"]])
+        hardness = im["distance_m"] / half_range_m
+        x, y, w, h = ann["bbox"]
+        if rng.uniform() < 1.0 / (1.0 + hardness**4):
+            j = rng.normal(0.0, 0.05 * hardness, 4)
+            dets.append({"image_id": im["id"], "category_id": 3, "bbox": [x + j[0] * w, y + j[1] * h, w * np.exp(j[2]), h * np.exp(j[3])],
+                         "score": float(rng.uniform(0.5, 1.0) / (1 + hardness))})
+        dets.append({"image_id": im["id"], "category_id": 3, "bbox": [*rng.uniform(0, 0.5, 2) * [im["width"], im["height"]], 20.0, 10.0],
+                     "score": float(rng.uniform(0.01, 0.3))})
+    return dets
+
+
+def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0, save_images=True,
+                    backend="faster-coco-eval", progress=None):
+    """Writes the files of a real run; detections from the synthetic detector."""
+    from PIL import Image, ImageDraw
+
+    from benchmark.run import sha256_bytes
+    from metricscenes.groundtruth import scale_groundtruth
+
+    out_dir = Path(out_dir)
+    (out_dir / "images").mkdir(parents=True, exist_ok=True)
+    half_range = 400.0 / camera.pixel_um * (1.0 if condition == "day" else 0.5)
+    gt = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px)
+    dets = synthetic_detections(gt, half_range, seed)
+    scenes = collection.scenes()
+    boxes = {a["image_id"]: a["bbox"] for a in gt["annotations"]}
+    for i, scene in enumerate(scenes):
+        if save_images:
+            img = Image.new("RGB", (camera.width_px, camera.height_px), (90, 110, 90) if condition == "day" else (10, 10, 20))
+            x, y, w, h = boxes[scene.image_id]
+            ImageDraw.Draw(img).rectangle([x, y, x + w, y + h], fill=(200, 40, 40))
+            img.save(out_dir / "images" / f"{scene.scene_id}.png", compress_level=1)
+        if progress:
+            progress(i + 1, len(scenes))
+    per_distance = ap_by_distance(gt, dets, backend=backend)
+    data = json.dumps(dets).encode()
+    results = {
+        "camera": {"name": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
+                   "width_px": camera.width_px, "height_px": camera.height_px, "spec_sha256": camera.sha256()},
+        "condition": condition,
+        "detector": {"name": detector.name, "sha256": detector.sha256, "input_size": detector.input_size},
+        "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
+        "seed": seed, "scoring_backend": backend, "per_distance": per_distance, "od50_m": None,
+        "detections_sha256": sha256_bytes(data),
+    }
+    (out_dir / "detections.json").write_bytes(data)
+    (out_dir / "groundtruth.json").write_text(json.dumps(gt))
+    (out_dir / "results.json").write_text(json.dumps(results))
+    return results
+
+
+class CountingRun:
+    """fake_run_camera that counts its calls and can die after ``die_after`` calls."""
+
+    def __init__(self, die_after: int | None = None):
+        self.calls: list[tuple[str, str]] = []
+        self.die_after = die_after
+
+    def __call__(self, collection, camera, condition, *args, **kwargs):
+        if self.die_after is not None and len(self.calls) >= self.die_after:
+            raise KeyboardInterrupt("killed")
+        self.calls.append((camera.name, condition))
+        return fake_run_camera(collection, camera, condition, *args, **kwargs)
+
+
+CAMERAS = ("cam01", "cam12")
+
+
+def make_fake_sweep(out: Path, monkeypatch, *, run=None, cameras=CAMERAS, conditions=("day", "night"), **kw):
+    """A sweep folder from the fake runs (public helper for the report tests)."""
+    monkeypatch.setattr("benchmark.run.run_camera", run or fake_run_camera)
+    kw.setdefault("n_resamples", 50)
+    kw.setdefault("mtf_source", "analytic")
+    kw.setdefault("save_images", False)  # the report tests ask for them
+    table = sweep_module.sweep(FakeCollection(out.parent), [load_camera(c) for c in cameras], list(conditions),
+                               FakeDetector(), out, **kw)
+    return table
+
+
+def test_table_shape_and_columns(tmp_path, monkeypatch):
+    events = []
+    table = make_fake_sweep(tmp_path / "sw", monkeypatch, progress=lambda d, t, label: events.append((d, t)))
+    assert list(table.columns) == sweep_module.TABLE_COLUMNS
+    assert len(table) == len(CAMERAS) * 2 * 6  # cameras × conditions × distances
+    assert set(table["camera"]) == set(CAMERAS) and set(table["condition"]) == {"day", "night"}
+    assert (table["n_images"] == N_ENV).all()
+    assert table["mtf50_source"].eq("analytic").all()
+    # the analytic MTF50 of the smaller pixel (cam12, 1.4 um f/1.9) is the higher
+    mtf = table.groupby("camera")["mtf50_cy_per_mm"].first()
+    assert mtf["cam12"] > mtf["cam01"]
+    on_disk = pd.read_csv(tmp_path / "sw" / "sweep.csv")
+    pd.testing.assert_frame_equal(on_disk, table, check_dtype=False)
+    meta = json.loads((tmp_path / "sw" / "sweep.json").read_text())
+    assert len(meta["table"]) == len(table) and meta["cameras"] == list(CAMERAS)
+    total = len(CAMERAS) * 2 * 6 * N_ENV
+    assert events[-1] == (total, total) and all(a[0] <= b[0] for a, b in zip(events, events[1:]))
+
+
+def test_od50_table_matches_bootstrap(tmp_path, monkeypatch):
+    make_fake_sweep(tmp_path / "sw", monkeypatch, n_resamples=40, seed=3)
+    od = pd.read_csv(tmp_path / "sw" / "od50.csv")
+    assert list(od.columns) == sweep_module.OD50_COLUMNS and len(od) == 4
+    run = tmp_path / "sw" / "runs" / "cam01-day"
+    oracle = bootstrap_od50(json.loads((run / "groundtruth.json").read_text()),
+                            json.loads((run / "detections.json").read_text()), n_resamples=40, seed=3)
+    row = od[(od.camera == "cam01") & (od.condition == "day")].iloc[0]
+    assert row.od50_m == pytest.approx(oracle["od50_m"])
+    assert row.sd_m == pytest.approx(oracle["sd_m"])
+    assert (row.ci95_lo_m, row.ci95_hi_m) == pytest.approx(oracle["ci95_m"])
+    assert row.n_resamples == 40 and row.n_environments == N_ENV
+
+
+def test_second_sweep_reuses_every_run(tmp_path, monkeypatch):
+    first = CountingRun()
+    t1 = make_fake_sweep(tmp_path / "sw", monkeypatch, run=first)
+    assert len(first.calls) == 4
+    mtimes = {p: p.stat().st_mtime_ns for p in (tmp_path / "sw" / "runs").rglob("*.json")}
+    second = CountingRun()
+    t2 = make_fake_sweep(tmp_path / "sw", monkeypatch, run=second)
+    assert second.calls == []
+    assert {p: p.stat().st_mtime_ns for p in mtimes} == mtimes  # nothing rewritten, bootstrap cached too
+    pd.testing.assert_frame_equal(t1, t2)
+    assert all(r["reused"] for r in json.loads((tmp_path / "sw" / "sweep.json").read_text())["runs"])
+
+
+def test_changed_key_reruns_only_that_part(tmp_path, monkeypatch):
+    make_fake_sweep(tmp_path / "sw", monkeypatch)
+    other_seed = CountingRun()
+    make_fake_sweep(tmp_path / "sw", monkeypatch, run=other_seed, seed=1)
+    assert len(other_seed.calls) == 4  # the seed is part of the key
+    night_only = CountingRun()
+    make_fake_sweep(tmp_path / "sw", monkeypatch, run=night_only, seed=1, conditions=("night",))
+    assert night_only.calls == []
+
+
+def test_killed_sweep_resumes_and_equals_uninterrupted(tmp_path, monkeypatch):
+    full = make_fake_sweep(tmp_path / "full", monkeypatch)
+    killed = CountingRun(die_after=2)
+    with pytest.raises(KeyboardInterrupt):
+        make_fake_sweep(tmp_path / "resumed", monkeypatch, run=killed)
+    (tmp_path / "resumed" / "runs" / "cam12-day").mkdir()  # a half-started run folder
+    (tmp_path / "resumed" / "runs" / "cam12-day" / "results.json").write_text('{"camera": ')
+    resumed = CountingRun()
+    table = make_fake_sweep(tmp_path / "resumed", monkeypatch, run=resumed)
+    assert resumed.calls == [("cam12", "day"), ("cam12", "night")]
+    pd.testing.assert_frame_equal(table, full)
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "resumed" / "od50.csv"), pd.read_csv(tmp_path / "full" / "od50.csv"))
+
+
+def test_mtf_sources_and_errors(tmp_path, monkeypatch):
+    cam = load_camera("cam05")
+    assert sweep_module.camera_mtf50(cam, "published") == (cam.mtf50_group_cy_per_mm, "published")
+    analytic, source = sweep_module.camera_mtf50(cam, "analytic")
+    assert source == "analytic" and 30 < analytic < 300
+    with pytest.raises(ValueError, match="mtf_source"):
+        sweep_module.camera_mtf50(cam, "guess")
+    with pytest.raises(ValueError, match="unknown condition 'dawn'"):
+        make_fake_sweep(tmp_path / "sw", monkeypatch, conditions=("dawn",))
+    with pytest.raises(ValueError, match="unique"):
+        make_fake_sweep(tmp_path / "sw", monkeypatch, cameras=("cam01", "cam01"))
+
+
+def test_json_is_strict(tmp_path, monkeypatch):
+    assert sweep_module._json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
+    make_fake_sweep(tmp_path / "sw", monkeypatch)
+    json.loads((tmp_path / "sw" / "sweep.json").read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))
