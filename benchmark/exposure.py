@@ -26,14 +26,18 @@ def central_region(shape: tuple[int, int], fraction: float) -> tuple[slice, slic
 def exposure_time_s(electron_rate: np.ndarray, sensor: SensorSpec, policy: ExposureSpec) -> float:
     """Integration time, s, for a noise-free electron-rate mosaic (rows, cols), e⁻/s.
 
-    ``auto_peak``: peak signal voltage in the central region at ``level`` × swing;
+    ``auto_peak``: peak signal voltage in the central region at ``level`` × swing, the
+    peak read as the ``peak_percentile`` of the region (100: the strict maximum);
     ``mean_level``: mean signal voltage there at ``level`` × swing; both capped at
     ``max_exposure_s`` (a black region gets the cap). ``fixed``: ``exposure_s``.
     """
     if policy.mode == "fixed":
         return float(policy.exposure_s)
     region = electron_rate[central_region(electron_rate.shape, policy.region_fraction)]
-    rate = float(np.max(region) if policy.mode == "auto_peak" else np.mean(region))
+    if policy.mode == "auto_peak":
+        rate = float(np.max(region) if policy.peak_percentile >= 100.0 else np.percentile(region, policy.peak_percentile))
+    else:
+        rate = float(np.mean(region))
     volts_per_s = rate * signal_volts_per_electron(sensor)
     if not np.isfinite(volts_per_s) or volts_per_s <= 0:
         return float(policy.max_exposure_s)

@@ -33,10 +33,32 @@ def test_auto_exposure_puts_the_central_peak_at_90_percent(name):
     cap = simulate(_textured_scene(1e-2), cam, seed=0, noise=False)
     assert cap.exposure_s < 0.016  # not at the cap: the policy itself is tested
     rows, cols = exposure.central_region(cap.electrons.shape, cam.exposure.region_fraction)
-    peak_v = cap.electrons[rows, cols].max() * cam.sensor.conversion_gain_uv_per_e * 1e-6
+    pct = cam.exposure.peak_percentile
+    peak_v = np.percentile(cap.electrons[rows, cols], pct) * cam.sensor.conversion_gain_uv_per_e * 1e-6
     assert abs(peak_v / cam.sensor.voltage_swing_v - 0.90) < 0.02
-    peak_dn = cap.raw_dn[rows, cols].max()
+    peak_dn = np.percentile(cap.raw_dn[rows, cols], pct)
     assert abs(peak_dn - (64 + 0.9 * 1023)) < 0.02 * 1023
+    # Only the brightest (100 - pct) % of the region may clip.
+    assert (cap.raw_dn[rows, cols] >= 1023).mean() <= (100 - pct) / 100 + 1e-3
+
+
+def test_strict_peak_policy_and_glint_rejection():
+    cam = load_camera("cam06")  # 1280 x 720: one scene pixel per sensor pixel below
+    rng = np.random.default_rng(3)
+    texture = rng.random((720, 1280, 1), dtype=np.float32) * (D65 * 1e-2).astype(np.float32)
+    scene = SpectralScene(layers=(RadianceLayer(texture, REFERENCE_EXTENT),))
+    glint = texture.copy()
+    glint[360, 640] *= 300  # one sun glint in the centre
+    glinted = SpectralScene(layers=(RadianceLayer(glint, REFERENCE_EXTENT),))
+    robust = simulate(glinted, cam, seed=0, noise=False)
+    plain = simulate(scene, cam, seed=0, noise=False)
+    assert robust.exposure_s == pytest.approx(plain.exposure_s, rel=0.02)
+    strict_cam = _with(cam, exposure={"peak_percentile": 100.0})
+    strict = simulate(glinted, strict_cam, seed=0, noise=False)
+    rows, cols = exposure.central_region(strict.electrons.shape, 0.5)
+    assert strict.exposure_s < plain.exposure_s / 10  # the glint alone sets the exposure
+    peak_v = strict.electrons[rows, cols].max() * 76.5e-6
+    assert abs(peak_v / 0.4591 - 0.90) < 0.02
 
 
 def test_auto_exposure_never_exceeds_16_ms():

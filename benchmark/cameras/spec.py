@@ -98,6 +98,11 @@ class ExposureSpec(BaseModel):
     level: float = Field(0.90, gt=0.0, le=1.0)
     region_fraction: float = Field(0.5, gt=0.0, le=1.0)
     """Side of the central region as a fraction of the frame's width and height."""
+    peak_percentile: float = Field(99.9, ge=90.0, le=100.0)
+    """``auto_peak`` reads the region's peak as this percentile of its noise-free signal.
+    100 is ISETCam's strict maximum; the default ignores the brightest 0.1 % (sun
+    glints on paint and glass, lamp cores), which a strict maximum lets set the
+    exposure of the whole frame (see docs/camera.md)."""
     max_exposure_s: float = Field(0.016, gt=0.0, le=60.0)
     exposure_s: float = Field(1.0 / 60.0, gt=0.0, le=60.0)
 
