@@ -29,6 +29,7 @@ def submit(
     detections: Annotated[Optional[list[Path]], typer.Option(help="with --check: a detections file to recompute AP from (repeatable, matched to a condition by sha256)")] = None,
     groundtruth: Annotated[Optional[Path], typer.Option(help="with --detections: the ground truth on the camera grid (a run's groundtruth.json)")] = None,
     n_resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples for OD50's SD")] = 1000,
+    seed: Annotated[int, typer.Option(min=0, help="bootstrap seed (a sweep's --seed reuses its cached od50.json)")] = 0,
     created_at: Annotated[Optional[str], typer.Option(help="fix the timestamp (YYYY-MM-DDTHH:MM:SSZ); default now, or SOURCE_DATE_EPOCH")] = None,
     mtf: Annotated[bool, typer.Option(help="measure MTF50 on the camera (else the published group)")] = True,
 ) -> None:
@@ -61,7 +62,7 @@ def submit(
             _fail(f"{results_dir} holds {len(groups)} cameras ({', '.join(groups)}): put {{camera}} in --name or choose one with --camera")
         protocols = load_protocols(leaderboard)
         subs = [build_submission(runs, name=name.replace("{camera}", cam), submitter=submitter, created_at=created_at,
-                                 n_resamples=n_resamples, measure_mtf=mtf, protocols=protocols)
+                                 n_resamples=n_resamples, seed=seed, measure_mtf=mtf, protocols=protocols)
                 for cam, runs in groups.items()]  # fmt: skip
         for sub in subs:  # all checked before any is written
             check_not_duplicate(sub, leaderboard)

@@ -20,16 +20,17 @@ from dataclasses import asdict, dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from metricscenes import __version__
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
-from metricscenes.groundtruth import box_tan_to_xywh, car_box_tan, coco_groundtruth
+from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco_groundtruth, mask_box_tan
 from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.store import (
     GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, write_atomic,
-    write_radiance,
+    write_mask, write_radiance,
 )
 
 # Margins of the inset window around the car's projected box, as fractions of the box:
@@ -84,7 +85,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     """Render and write one unit (runs in a worker process); return its progress record."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
-    from metricscenes.render import Film, illuminance_meter, render_radiance, use_variant
+    from metricscenes.render import Film, RenderError, illuminance_meter, render_depth, render_radiance, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
     use_variant(manifest.render.variant, threads)
@@ -100,6 +101,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         extent = REFERENCE_EXTENT
     else:
         pose = scene_mod.car_pose(env, unit.distance_m)
+        env_parts = parts
         parts = parts.merged(scene_mod.car_parts(env, pose))
         box = car_box_tan(scene_mod.car_vertices(env, pose))
         k, cx, cy, cw, ch = inset_window(box, manifest)
@@ -108,8 +110,17 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         e = REFERENCE_EXTENT
         extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
                            e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
-        record.update(box_tan=list(box), inset_scale=k, pose=asdict(pose),
-                      bbox_xywh=box_tan_to_xywh(box, ref_w, ref_h))
+        # Instance mask: the rays whose first hit moves when the car is added.
+        depth_with, depth_without = (
+            render_depth(scene_mod.scene_dict(env, p, groups[0], film, spp=1, seed=unit.seed, max_depth=2), film)
+            for p in (parts, env_parts))
+        mask = (depth_with > 0) & (depth_with != depth_without)
+        mask_box = mask_box_tan(mask, extent)
+        if mask_box is None:
+            raise RenderError(f"{unit.key}: the car is not visible in its inset")
+        write_mask(root, unit.key, mask, extent)
+        record.update(box_tan=list(mask_box), projected_box_tan=list(box), mask_iou=round(box_iou(mask_box, box), 4),
+                      inset_scale=k, pose=asdict(pose), bbox_xywh=box_tan_to_xywh(mask_box, ref_w, ref_h))
     jobs = [(kind, group, film, spp, extent) for group in groups]
     if unit.kind == "inset" and "car_lights" in groups:
         # The car's lamps light the road far outside its inset (an oncoming car's beams
@@ -157,7 +168,7 @@ def _prepare(root: Path, manifest: Manifest) -> None:
     zroot = zarr.open_group(str(root / RADIANCE_STORE), mode="a")
     zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
                         "dimension_names": ["y", "x", "wavelength"]})
-    for name in ("plates", "insets", "frames"):
+    for name in ("plates", "insets", "frames", "masks"):
         zroot.require_group(name)
 
 
@@ -211,6 +222,7 @@ def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: 
             "id": s.image_id, "file_name": f"{s.scene_id}.png", "width": ref_w, "height": ref_h,
             "scene_id": s.scene_id, "environment_id": env.environment_id, "distance_m": s.distance_m,
             "car_id": env.car_id, "road_id": env.road_id, "heading": env.heading,
+            "mask_vs_projection_iou": rec["mask_iou"],
         })
         boxes.append(rec["bbox_xywh"])
     info = {"description": f"metricscenes collection {manifest.name}", "version": __version__,

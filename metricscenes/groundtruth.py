@@ -1,9 +1,10 @@
 """COCO ground truth: one ``car`` box per scene in the reference pixel grid.
 
-The box is the tight box of the car's projected mesh vertices, clipped to the image
-(the car is never occluded: trees and poles stand off the road). Boxes are floats in
-reference-grid pixels; a camera scales them to its own grid by its size ratio, as
-every camera covers the same field of view.
+The box is the tight box of the car's visible pixels in a rendered instance mask (at
+the inset's sampling, at least twice finer than the finest camera pixel for all but
+the nearest cars), cross-checked against the box of the car's projected mesh
+vertices. Boxes are floats in reference-grid pixels; a camera scales them to its own
+grid by its size ratio, as every camera covers the same field of view.
 """
 
 from __future__ import annotations
@@ -19,6 +20,28 @@ def car_box_tan(vertices_world_m: np.ndarray) -> tuple[float, float, float, floa
     """Tight box (x0, y0, x1, y1) of the projected vertices in tangent coordinates."""
     t = world_to_tan(vertices_world_m)
     return (float(t[:, 0].min()), float(t[:, 1].min()), float(t[:, 0].max()), float(t[:, 1].max()))
+
+
+def mask_box_tan(mask: np.ndarray, extent) -> tuple[float, float, float, float] | None:
+    """Tight box (x0, y0, x1, y1), tangent coordinates, of the True pixels of a mask
+    sampled uniformly over ``extent`` (pixel edges, not centres). None if empty."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    if rows.size == 0:
+        return None
+    n_rows, n_cols = mask.shape
+    px, py = extent.width / n_cols, extent.height / n_rows
+    return (extent.x0 + cols[0] * px, extent.y0 + rows[0] * py,
+            extent.x0 + (cols[-1] + 1) * px, extent.y0 + (rows[-1] + 1) * py)
+
+
+def box_iou(a, b) -> float:
+    """IoU of two (x0, y0, x1, y1) boxes."""
+    iw = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    ih = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    inter = iw * ih
+    union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
+    return inter / union if union > 0 else 0.0
 
 
 def box_tan_to_xywh(box_tan, width_px: int, height_px: int) -> list[float]:

@@ -140,3 +140,30 @@ def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed:
         "sampler": {"type": "stratified", "sample_count": ILLUMINANCE_METER_SPP, "seed": int(seed) % 2**31},
     }
     return np.pi * render_radiance(scene, ILLUMINANCE_METER_SPP).reshape(-1)
+
+
+def render_depth(scene_dict: dict, film: Film) -> np.ndarray:
+    """Distance (m) along each pixel's ray to the first surface, 0 where it escapes.
+
+    One sample per pixel at positions fixed by the sensor's seed, so two scenes
+    rendered with the same film and seed are probed along the same rays.
+    """
+    import mitsuba as mi
+
+    cols, rows = film.size
+    scene = dict(scene_dict)
+    scene["integrator"] = {"type": "aov", "aovs": "dd:depth"}
+    sensor = dict(scene["sensor"])
+    sensor["film"] = {
+        "type": "hdrfilm", "width": film.width, "height": film.height, "crop_offset_x": film.crop_x,
+        "crop_offset_y": film.crop_y, "crop_width": cols, "crop_height": rows, "rfilter": {"type": "box"},
+        "pixel_format": "luminance",
+    }
+    sensor["sampler"] = {"type": "independent", "sample_count": 1, "seed": sensor["sampler"]["seed"]}
+    scene["sensor"] = sensor
+    try:
+        image = np.array(mi.render(mi.load_dict(scene), spp=1))
+    except Exception as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise RenderError(f"depth render failed: {first}") from exc
+    return image[..., -1].astype(np.float32)

@@ -21,6 +21,7 @@ from metricscenes.render import Film, sensor_dict
 SKY_GROUPS = {"sky_day": "sky_day_id", "sky_dusk": "sky_dusk_id", "sky_night": "sky_night_id"}
 
 
+
 @dataclass(frozen=True)
 class CarPose:
     """Where the car stands: ground point under its centre (world m) and yaw (rad, 0 = facing +x)."""

@@ -6,6 +6,7 @@ Layout of a collection folder::
       plates/<env>/<light_group>        (y, x, wavelength) float32, whole field of view
       insets/<scene>/<light_group>      (y, x, wavelength) float32, a window around the car
       frames/<scene>/car_lights         (y, x, wavelength) float32, the car's lamps over the whole view
+      masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, sha256 of every array
     progress/<unit>.json                one record per finished unit of work (resume)
@@ -77,6 +78,18 @@ def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.
     )
     arr[...] = cube
     return array_sha256(cube)
+
+
+def write_mask(root: Path, unit: str, mask: np.ndarray, extent: TanExtent) -> None:
+    """Write a scene's instance mask (True = car) over its inset window."""
+    import zarr
+
+    arr = zarr.create_array(
+        store=str(root / RADIANCE_STORE), name=f"masks/{unit}", shape=mask.shape, dtype="bool",
+        chunks=mask.shape, dimension_names=("y", "x"), overwrite=True,
+        attributes={"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"},
+    )
+    arr[...] = mask
 
 
 @dataclass(frozen=True)

@@ -143,3 +143,22 @@ def test_photometry_and_illuminance_sweep(smoke_collection):
             day["mean_luminance_cd_m2"] * level / day["illuminance_at_camera_lux"], rel=1e-4)
     # E = pi L / (1 + 4 N^2) for an ideal f/2.4 lens.
     assert day["image_plane_illuminance_lux"] == pytest.approx(np.pi * day["mean_luminance_cd_m2"] / (1 + 4 * 2.4**2))
+
+
+def test_boxes_come_from_the_instance_mask_and_agree_with_the_projection(smoke_collection):
+    import zarr
+
+    from metricscenes.geometry import TanExtent
+    from metricscenes.groundtruth import box_tan_to_xywh, mask_box_tan
+
+    gt = json.loads((smoke_collection / "groundtruth.json").read_text())
+    root = zarr.open_group(str(smoke_collection / "radiance.zarr"), mode="r")
+    boxes = {a["image_id"]: a["bbox"] for a in gt["annotations"]}
+    for img in gt["images"]:
+        # The mask box and the projected mesh box agree (no occlusion, fine sampling).
+        assert img["mask_vs_projection_iou"] >= 0.9, img["scene_id"]
+        arr = root[f"masks/{img['scene_id']}"]
+        mask = np.asarray(arr[...])
+        assert mask.dtype == bool and 0 < mask.mean() < 1
+        box = mask_box_tan(mask, TanExtent(*arr.attrs["extent_tan"]))
+        np.testing.assert_allclose(box_tan_to_xywh(box, img["width"], img["height"]), boxes[img["id"]], atol=1e-3)

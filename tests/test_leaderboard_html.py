@@ -90,11 +90,9 @@ def test_page_loads_without_console_errors(chromium_works, page, tmp_path):
     [
         ("sort=pixel_um", ["sys-cam12", "sys-cam03", "sys-cam01"]),
         ("sort=-pixel_um", ["sys-cam01", "sys-cam03", "sys-cam12"]),
-        ("sort=day_od50", ["sys-cam01", "sys-cam12", "sys-cam03"]),
         ("sort=-system", ["sys-cam12", "sys-cam03", "sys-cam01"]),
         ("sort=night_od50", ["sys-cam03", "sys-cam01", "sys-cam12"]),  # no night value: last either way
         ("sort=-night_od50", ["sys-cam01", "sys-cam03", "sys-cam12"]),
-        ("sort=-rank", ["sys-cam01", "sys-cam12", "sys-cam03"]),
     ],
 )
 def test_sorting_by_column(chromium_works, page, tmp_path, fragment, expected):

@@ -313,4 +313,4 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     assert cells[0] == "1" and cells[2] == "cam01" and cells[3].split(" ±")[0] == expected
     html = (lb / "index.html").read_text()
     assert 'href="submissions/cam01-yolov5n-smoke.json"' in html and f">{expected}" in html
-    assert math.isclose(float(cells[7]), 4.2)  # pixel pitch column
+    assert math.isclose(float(cells[6]), 4.2) and math.isclose(float(cells[7]), 3.1)  # pixel pitch, f-number

@@ -181,7 +181,7 @@ BAD = [
     ("spec-edited", _edit(_pixel), "good.json", "camera.spec_sha256"),
     ("spec-hash-edited", _edit(lambda s: s["camera"].update(spec_sha256="0" * 64)), "good.json", "does not match the spec's content"),
     ("spec-invalid", _edit(_bad_spec_rehashed), "good.json", "field 'sensor.pixel_um' = 100.0"),
-    ("spec-derived-edited", _edit(_derived_width), "good.json", "not a resolved camera spec"),
+    ("spec-derived-edited", _edit(_derived_width), "good.json", "camera.spec: sensor.width_px is not what the spec resolves to"),
     ("isp-differs", _edit(lambda s: s["isp"].update(demosaic="bilinear")), "good.json", "isp differs from camera.spec.isp"),
     ("unknown-protocol", _edit(lambda s: s["collection"].update(protocol="homebrew")), "good.json", "protocol 'homebrew' is not accepted"),
     ("manifest-not-accepted", _edit(lambda s: s["collection"].update(manifest_sha256="ab" * 32)), "good.json",

@@ -28,7 +28,7 @@ from benchmark.leaderboard.validate import SUBMISSIONS, read_submission_file, va
 
 REPRODUCE = """\
 metricscenes generate --manifest manifests/quick.yaml --out collections/quick
-benchmark sweep --collection collections/quick --model yolov5n-dynamic --out sweeps/quick
+benchmark sweep --collection collections/quick --conditions day,dusk,night --model yolov5n-dynamic --out sweeps/quick
 benchmark submit sweeps/quick --name 'ref-{camera}-yolov5n-quick' --submitter 'metricscenes reference'
 benchmark leaderboard"""
 
@@ -191,7 +191,7 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
         if not subs:
             out += ['<p class="empty">No submissions yet.</p>', "</section>"]
             continue
-        out.append(f'<table class="sortable" data-protocol="{esc(protocol.name)}">')
+        out.append(f'<div class="scroll"><table class="sortable" data-protocol="{esc(protocol.name)}">')
         out.append("<thead><tr>" + "".join(
             f'<th data-key="{c.key}" data-type="{c.kind}" aria-sort="{"ascending" if c.key == "rank" else "none"}">'
             f'<button type="button">{esc(c.header)}</button></th>' for c in cols) + "</tr></thead>")  # fmt: skip
@@ -202,9 +202,9 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
             for c in cols:
                 value, text = cells[c.key]
                 body = f'<a href="submissions/{esc(sub["name"])}.json">{esc(text)}</a>' if c.key == "system" else esc(text)
-                tds.append(f'<td data-v="{esc(value)}">{body}</td>')
+                tds.append(f'<td data-v="{esc(value)}"{" class=t" if c.kind == "str" else ""}>{body}</td>')
             out.append(f'<tr data-name="{esc(sub["name"])}">' + "".join(tds) + "</tr>")
-        out += ["</tbody>", "</table>", "</section>"]
+        out += ["</tbody>", "</table></div>", "</section>"]
     out += [f"<script>{script}</script>", "</body>", "</html>", ""]
     return "\n".join(out)
 

@@ -73,16 +73,33 @@ def _without_computed(model, data):
     return out
 
 
+def _first_difference(given, resolved, where: str = "") -> str | None:
+    """Path of the first value of ``given`` that ``resolved`` does not repeat (keys only in ``resolved`` are fine)."""
+    if isinstance(given, dict) and isinstance(resolved, dict):
+        for key in sorted(given):
+            found = _first_difference(given[key], resolved.get(key), f"{where}.{key}" if where else key)
+            if found:
+                return found
+        return None
+    return None if given == resolved else where
+
+
 def camera_from_dump(spec: dict, source: str = "camera.spec"):
-    """The :class:`CameraSpec` of a resolved dump (as in results.json); the dump must be exactly its re-dump."""
+    """The :class:`CameraSpec` of a resolved dump (as in results.json).
+
+    Every value of the dump, derived ones (``sensor.width_px``) included, must be what the
+    spec resolves to; fields the dump lacks take the current defaults (a spec written
+    before a field was added still reads).
+    """
     from benchmark.cameras import CameraSpec, camera_from_dict
 
     try:
         camera = camera_from_dict(_without_computed(CameraSpec, spec), source=source)
     except ValueError as exc:
         raise SubmissionError(str(exc).splitlines()[0]) from None
-    if camera.model_dump(mode="json") != spec:
-        raise SubmissionError(f"{source}: not a resolved camera spec (its fields or derived values differ from the re-resolved spec)")
+    where = _first_difference(spec, camera.model_dump(mode="json"))
+    if where:
+        raise SubmissionError(f"{source}: {where} is not what the spec resolves to (derived values must not be edited)")
     return camera
 
 
