@@ -61,7 +61,7 @@ def _surface_frame(body: BodyShape, y: float, z: float, front: bool, offset_m: f
     x0 = float(xs[0])
     gy = float(xs[1] - xs[2]) / (2 * d)
     gz = float(xs[3] - xs[4]) / (2 * d)
-    n = np.array([1.0, -gy, -gz]) * (1.0 if front else -1.0)
+    n = np.array([1.0, -0.5 * gy, -gz]) * (1.0 if front else -1.0)  # half the wrap: lamps sit flush
     n /= np.linalg.norm(n)
     p = np.array([x0, y, z]) + offset_m * n
     e1 = np.cross([0.0, 0.0, 1.0], n)
@@ -75,7 +75,7 @@ def conformal_patch(body: BodyShape, front: bool, yc, zc, half_y, half_z, offset
     """Rounded-rectangle patch following the front/rear surface (grilles, plates, housings)."""
     ny, nz = n
     t = np.linspace(-1, 1, nz)
-    scale = (1 - np.abs(t) ** roundness) ** (1 / roundness)
+    scale = (1 - np.abs(0.97 * t) ** roundness) ** (1 / roundness)  # 0.97: keep the end rows wide
     s = np.linspace(-1, 1, ny)
     zz = np.broadcast_to((zc + half_z * t)[:, None], (nz, ny))
     yy = yc + half_y * scale[:, None] * s[None]
@@ -139,8 +139,8 @@ def split_greenhouse(body: BodyShape, v, f, s_v, env, h_v, pillar_m=0.075, b_pil
     in_front = x > x_rf + 0.03
     in_rear = x < x_rr - 0.03
     pillar = np.where(in_rear, 1.6 * pillar_m, pillar_m)  # C/D pillars are wider than A pillars
-    screen = (in_front | in_rear) & ~side & (y < env_c - pillar) & (s_c > 0.12) & (h_c * (1 - s_c) > 0.02)
-    screen &= ~in_rear | (s_c < 0.93)  # roof spoiler / rear header band
+    in_rear &= x < x_rr - 0.07  # painted header / spoiler band above the rear window
+    screen = (in_front | in_rear) & ~side & (y < env_c - pillar) & (s_c > 0.12)
     x_b = 0.5 * (x_rr + x_rf) + 0.05 * (x_rf - x_rr)
     side_glass = (side & (h_c * (1 - s_c) > rail_m) & (h_c * s_c > 0.025) & (h_c > 0.2)
                   & (np.abs(x - x_b) > b_pillar_m))

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 LIGHT_GROUPS = ("car_lights", "street_lights")
+SPECTRUM_PAD_NM = (380.0, 720.0)
 
 
 @dataclass(frozen=True)
@@ -56,13 +57,20 @@ class SceneParts:
 
 
 def spectrum(wavelengths_nm, values) -> dict:
-    """Mitsuba ``irregular`` spectrum dict from wavelengths (nm, increasing) and values."""
+    """Mitsuba ``irregular`` spectrum dict from wavelengths (nm, increasing) and values;
+    a table that stops inside 380-720 nm is held constant out to those ends."""
     wl = np.asarray(wavelengths_nm, dtype=float).ravel()
     val = np.asarray(values, dtype=float).ravel()
     if wl.shape != val.shape or wl.size < 2:
         raise ValueError(f"spectrum needs >= 2 matching wavelengths and values, got {wl.size} and {val.size}")
     if np.any(np.diff(wl) <= 0):
         raise ValueError("spectrum wavelengths_nm must be strictly increasing")
+    # Mitsuba reads an irregular spectrum as zero outside its table, and the end bands
+    # span 395-405 and 695-705 nm: hold the end values out to 380 and 720 nm.
+    if wl[0] > SPECTRUM_PAD_NM[0]:
+        wl, val = np.r_[SPECTRUM_PAD_NM[0], wl], np.r_[val[0], val]
+    if wl[-1] < SPECTRUM_PAD_NM[1]:
+        wl, val = np.r_[wl, SPECTRUM_PAD_NM[1]], np.r_[val, val[-1]]
     return {
         "type": "irregular",
         "wavelengths": ", ".join(f"{w:.6g}" for w in wl),
