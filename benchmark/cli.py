@@ -73,6 +73,91 @@ def run(
     console.print(f"wrote {out / 'results.json'}")
 
 
+@app.command()
+def sweep(
+    collection: Annotated[Path, typer.Option(help="collection folder written by `metricscenes generate`")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="sweep folder (runs are cached and reused there)")],
+    cameras: Annotated[str, typer.Option(help="'all' or a comma list: cam01,cam05 (names, numbers or YAML paths)")] = "all",
+    conditions: Annotated[str, typer.Option(help="comma list of the collection's conditions")] = "day,night",
+    model: Annotated[str, typer.Option(help="detector: registry name or .onnx path")] = "yolov5n-dynamic",
+    input_size: Annotated[str, typer.Option(
+        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = "multiscale",
+    resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples of OD50 (over environments)")] = 1000,
+    seed: Annotated[int, typer.Option(help="sensor noise and bootstrap seed")] = 0,
+    mtf_source: Annotated[str, typer.Option(help="MTF50 of each camera: measured | analytic | published")] = "measured",
+    threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
+    save_images: Annotated[bool, typer.Option(help="write the cameras' sRGB images (for the report's strips)")] = True,
+) -> None:
+    """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
+    from benchmark import sweep as sweep_module
+    from benchmark.cameras import camera_names, load_camera
+    from benchmark.detectors import DetectorError, load_detector
+    from metricscenes.store import Collection, CollectionError
+
+    try:
+        names = camera_names() if cameras.strip().lower() == "all" else [c.strip() for c in cameras.split(",") if c.strip()]
+        cams = [load_camera(name) for name in names]
+        col = Collection.open(collection)
+        conds = [c.strip() for c in conditions.split(",") if c.strip()]
+        known = list(getattr(col, "condition_names", col.conditions))
+        for condition in conds:
+            if condition not in known:
+                fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
+        if mtf_source not in sweep_module.MTF_SOURCES:
+            fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF_SOURCES)}, got {mtf_source!r}")
+        detector = load_detector(model, input_size=input_size, threads=threads)
+    except (ValueError, DetectorError, CollectionError) as exc:
+        fail(str(exc).splitlines()[0])
+    if not cams or not conds:
+        fail("--cameras and --conditions must each name at least one")
+    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), TimeRemainingColumn(), console=err) as bar:
+        task = bar.add_task("sweep", total=None)
+
+        def progress(done: int, total: int, label: str) -> None:
+            bar.update(task, completed=done, total=total, description=label)
+
+        try:
+            sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
+                               progress=progress, mtf_source=mtf_source, save_images=save_images)
+        except (ValueError, DetectorError, CollectionError, OSError) as exc:
+            fail(str(exc).splitlines()[0])
+    _, od50_table = sweep_module.load_sweep(out)
+    table = Table(title=f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments")
+    table.add_column("camera")
+    table.add_column("MTF50 (cy/mm)", justify="right")
+    for condition in conds:
+        table.add_column(condition, justify="right")
+    for camera_name, rows in od50_table.groupby("camera", sort=False):
+        by_condition = rows.set_index("condition")
+        cells = []
+        for condition in conds:
+            od, sd = by_condition.loc[condition, "od50_m"], by_condition.loc[condition, "sd_m"]
+            cells.append("∞" if od == float("inf") else f"{od:.1f} ± {sd:.1f}" if sd == sd else f"{od:.1f}")
+        mtf = rows["mtf50_cy_per_mm"].iloc[0]
+        table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})", *cells)
+    console.print(table)
+    console.print(f"wrote {out / 'sweep.csv'}, {out / 'od50.csv'}")
+
+
+@app.command()
+def report(
+    results_dir: Annotated[Path, typer.Argument(help="a `benchmark sweep` folder or a `benchmark run` folder")],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="HTML page (default RESULTS_DIR/report.html)")] = None,
+) -> None:
+    """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips."""
+    from benchmark.report import report as write_report
+
+    if not results_dir.is_dir():
+        fail(f"results folder not found: {results_dir}")
+    try:
+        with err.status("writing the report"):
+            page = write_report(results_dir, out)
+    except (ValueError, OSError, KeyError) as exc:
+        fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+    console.print(f"wrote {page} (figures in {page.parent / 'figures'})")
+
+
 def main() -> None:
     app(prog_name="benchmark")
 

@@ -28,11 +28,19 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from benchmark import spm  # noqa: E402
-from benchmark.sweep import TABLE_COLUMNS, camera_mtf50, load_sweep, run_name, run_od50  # noqa: E402
+from benchmark.sweep import (  # noqa: E402
+    TABLE_COLUMNS,
+    camera_mtf50,
+    illuminance_table,
+    load_sweep,
+    parse_illuminance_condition,
+    run_name,
+    run_od50,
+)
 
 GT_COLOUR, DET_COLOUR = (0, 200, 0), (230, 0, 0)
 CAR_CATEGORY_ID = 3
-THUMB_WIDTH_PX = 240
+THUMB_WIDTH_PX = 320
 
 
 def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[str, str], Path], dict]:
@@ -102,7 +110,7 @@ def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
 
 
 def crop_with_boxes(image_path: Path, gt_box, det, *, width_px: int = THUMB_WIDTH_PX):
-    """A PIL thumbnail around the car: the crop spans 4 car widths (at least 15 % of the
+    """A PIL thumbnail around the car: the crop spans 4 car widths (at least 12 % of the
     frame), the same fraction of the field of view for every camera; boxes drawn on the
     thumbnail so their lines stay crisp. ``gt_box``/``det['bbox']`` are COCO xywh pixels."""
     from PIL import Image, ImageDraw
@@ -110,7 +118,7 @@ def crop_with_boxes(image_path: Path, gt_box, det, *, width_px: int = THUMB_WIDT
     img = Image.open(image_path).convert("RGB")
     w, h = img.size
     bx, by, bw, bh = gt_box
-    frac = float(np.clip(4.0 * bw / w, 0.15, 1.0))
+    frac = float(np.clip(4.0 * bw / w, 0.12, 1.0))
     cw, ch = frac * w, frac * h
     x0 = float(np.clip(bx + bw / 2 - cw / 2, 0, w - cw))
     y0 = float(np.clip(by + bh / 2 - ch / 2, 0, h - ch))
@@ -167,18 +175,15 @@ def report(results_dir, out=None) -> Path:
     table, od50, runs, meta = load_results(results_dir)
     out = Path(out) if out is not None else results_dir / "report.html"
     fig_dir = out.parent / "figures"
-    figures = []  # (title, caption, figure)
-    figures.append(("AP vs distance", "COCO AP@[.5:.95] for the car at each distance; one line per camera, "
-                    "coloured by MTF50; the dotted line is AP 0.5 (OD50).", plot_ap_curves(table, fig_dir / "ap_vs_distance")))
-    per_cond = table.groupby("condition")["mtf50_cy_per_mm"].nunique()
-    if table["mtf50_cy_per_mm"].notna().all() and (per_cond >= 2).all():
-        mark = 100.0 if table["mtf50_cy_per_mm"].min() <= 100 <= table["mtf50_cy_per_mm"].max() else None
-        figures.append(("System Performance Maps", "AP over (distance, MTF50), linearly interpolated between the "
-                        "measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5; dashed: OD50 at "
-                        "MTF50 100 cy/mm.", spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark)))
-    if od50["camera"].nunique() >= 2 and od50["mtf50_cy_per_mm"].notna().all():
-        figures.append(("OD50 vs MTF50", "OD50 ± bootstrap SD over environments; least-squares line per "
-                        "condition, its slope in the legend.", spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50")))
+    is_lux = table["condition"].map(parse_illuminance_condition).notna()
+    main, main_od50 = table[~is_lux], od50[~od50["condition"].map(parse_illuminance_condition).notna()]
+    figures = _main_figures(main, main_od50, fig_dir) if not main.empty else []
+    lux = illuminance_table(table)
+    for camera, part in lux.groupby("camera", sort=False):
+        if part["illuminance_lux"].nunique() >= 2 and part["distance_m"].nunique() >= 2:
+            figures.append((f"SPM over illuminance · {camera}", "AP over (distance, scene illuminance) of the "
+                            "collection's illuminance sweep, interpolated linearly in log illuminance.",
+                            spm.spm_illuminance(part, fig_dir / f"spm_illuminance_{camera}")))
     sections = []
     for title, caption, fig in figures:
         sections.append(f"<h2>{html.escape(title)}</h2><figure><img alt='{html.escape(title)}' src='data:image/png;base64,"
@@ -186,7 +191,7 @@ def report(results_dir, out=None) -> Path:
         plt.close(fig)
     summary = summary_table(table, od50)
     sections.append("<h2>Results</h2>" + summary.to_html(index=False, classes="results", border=0, escape=True))
-    strips = image_strips(runs, table)
+    strips = image_strips({k: v for k, v in runs.items() if parse_illuminance_condition(k[1]) is None}, table)
     if strips:
         sections.append("<h2>Images</h2><p>First environment, cropped around the car at the same field of view for "
                         "every camera; <span style='color:#0a0'>green</span>: ground truth, "
@@ -200,9 +205,26 @@ def report(results_dir, out=None) -> Path:
     return out
 
 
+def _main_figures(table: pd.DataFrame, od50: pd.DataFrame, fig_dir: Path) -> list[tuple]:
+    """(title, caption, figure) of the curves, the MTF50 SPMs and OD50 vs MTF50 (where defined)."""
+    figures = [("AP vs distance", "COCO AP@[.5:.95] for the car at each distance; one line per camera, coloured by "
+                "MTF50; the dotted line is AP 0.5 (OD50).", plot_ap_curves(table, fig_dir / "ap_vs_distance"))]
+    per_condition = table.groupby("condition")["mtf50_cy_per_mm"].nunique()
+    if table["mtf50_cy_per_mm"].notna().all() and (per_condition >= 2).all():
+        mark = 100.0 if table["mtf50_cy_per_mm"].min() <= 100 <= table["mtf50_cy_per_mm"].max() else None
+        figures.append(("System Performance Maps", "AP over (distance, MTF50), linearly interpolated between the "
+                        "measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5; dashed: OD50 at "
+                        "MTF50 100 cy/mm.", spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark)))
+    if od50["camera"].nunique() >= 2 and od50["mtf50_cy_per_mm"].notna().all():
+        figures.append(("OD50 vs MTF50", "OD50 ± bootstrap SD over environments; least-squares line per "
+                        "condition, its slope in the legend.", spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50")))
+    return figures
+
+
 def _thumb_html(item: dict) -> str:
     caption = f"{item['camera']} · AP {item['ap']:.2f}"
-    caption += " · no car detection" if item["score"] is None else f" · best car {item['score']:.2f}"
+    score = item["score"]
+    caption += " · no car detection" if score is None else f" · best car {score:.2f}" if score >= 0.01 else " · best car < 0.01"
     return (f"<figure class='thumb'><img alt='{html.escape(item['scene_id'])}' src='data:image/png;base64,{item['png']}'>"
             f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 

@@ -76,7 +76,7 @@ def _draw_map(ax, gx, gy, gz, px, py, *, cmap: str = "viridis"):
     widths = [1.8 if abs(level - 0.5) < 1e-9 else 0.7 for level in lines.levels]  # the OD50 contour
     lines.set_linewidths(widths)
     ax.clabel(lines, fmt="%.1f", fontsize=7, inline=True)
-    ax.scatter(px, py, s=14, c="white", edgecolors="k", linewidths=0.6, zorder=3, label="measured")
+    ax.scatter(px, py, s=14, c="white", edgecolors="k", linewidths=0.6, zorder=3, label="measured", clip_on=False)
     return filled
 
 

@@ -25,6 +25,8 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
+import warnings
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -37,6 +39,8 @@ TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_sou
                  "distance_m", "ap", "ap50", "n_images"]
 OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
                 "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite"]
+
+_ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")
 
 Progress = Callable[[int, int, str], None]
 
@@ -116,7 +120,10 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
         pass
     gt = json.loads((run_dir / "groundtruth.json").read_text())
     dets = json.loads((run_dir / "detections.json").read_text())
-    out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=results.get("scoring_backend", "faster-coco-eval"))
+    with warnings.catch_warnings(), np.errstate(invalid="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)  # inf - inf of resamples whose OD50 is infinite
+        out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed,
+                             backend=results.get("scoring_backend", "faster-coco-eval"))
     out = {**out, "ci95_m": list(out["ci95_m"])}
     _write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
     return _json_safe(out)
@@ -154,9 +161,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     conditions = list(conditions)
     if not cameras or not conditions:
         raise ValueError("sweep needs at least one camera and one condition")
+    known = list(getattr(collection, "condition_names", collection.conditions))  # with the illuminance sweep's
     for condition in conditions:
-        if condition not in collection.conditions:
-            raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(collection.conditions)})")
+        if condition not in known:
+            raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
     names = [c.name for c in cameras]
     if len(set(names)) != len(names):
         raise ValueError(f"camera names must be unique, got {names}")
@@ -210,6 +218,23 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     }
     _write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
     return table
+
+
+def parse_illuminance_condition(condition: str) -> tuple[str, float] | None:
+    """``"day@0.25lux"`` → ``("day", 0.25)`` (an illuminance-sweep condition of
+    :attr:`metricscenes.store.Collection.condition_names`); None for other names."""
+    match = _ILLUMINANCE_CONDITION.fullmatch(str(condition))
+    return (match["base"], float(match["lux"])) if match else None
+
+
+def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The illuminance-sweep rows of a sweep table with ``base_condition`` and
+    ``illuminance_lux`` columns (the input of :func:`benchmark.spm.spm_illuminance`)."""
+    parsed = table["condition"].map(parse_illuminance_condition)
+    part = table[parsed.notna()].copy()
+    part["base_condition"] = [p[0] for p in parsed[parsed.notna()]]
+    part["illuminance_lux"] = [p[1] for p in parsed[parsed.notna()]]
+    return part
 
 
 def load_sweep(out_dir) -> tuple[pd.DataFrame, pd.DataFrame]:

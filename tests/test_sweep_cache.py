@@ -38,6 +38,7 @@ class FakeCollection:
     def __init__(self, root: Path, manifest_sha256: str = "f" * 64):
         self.root, self.name, self.protocol, self.manifest_sha256 = Path(root), "fake", "fake", manifest_sha256
         self.conditions = {"day": {"sky_day": 1.0}, "night": {"sky_night": 1.0}}
+        self.condition_names = [*self.conditions, "day@1lux", "day@100lux"]  # an illuminance sweep
         self._gt, _ = synthetic_collection(N_ENV, seed=1)
 
     def scenes(self):
@@ -83,7 +84,8 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
 
     out_dir = Path(out_dir)
     (out_dir / "images").mkdir(parents=True, exist_ok=True)
-    half_range = 400.0 / camera.pixel_um * (1.0 if condition == "day" else 0.5)
+    light = {"day": 1.0, "night": 0.5, "day@1lux": 0.3, "day@100lux": 0.9}[condition]
+    half_range = 400.0 / camera.pixel_um * light
     gt = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px)
     dets = synthetic_detections(gt, half_range, seed)
     scenes = collection.scenes()

@@ -1,0 +1,75 @@
+"""Acceptance checks of a sweep against the paper's qualitative findings (issue 5).
+
+Liu et al., EI 2023 report, for the 13 cameras:
+
+1. AP falls with distance (Fig. 5): here, in daylight, Spearman's rho of AP against
+   distance is <= -0.8 for every camera;
+2. night is harder than day (Fig. 5, right): night AP below day AP at every distance
+   for every camera. Where both are 0 the camera sees nothing in either light; such
+   pairs cannot be "below" and do not count against the finding (they are counted in
+   ``night_day_ties_at_zero``);
+3. OD50 rises with MTF50 in daylight (Fig. 7A): Spearman's rho of OD50 against MTF50
+   across cameras >= 0.6 (infinite OD50s rank above every finite one).
+
+:func:`paper_findings` returns each verdict (bool) with the statistic behind it (float).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+AP_DISTANCE_RHO_MAX = -0.8
+OD50_MTF50_RHO_MIN = 0.6
+
+
+def _spearman(x, y) -> float:
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = ~(np.isnan(x) | np.isnan(y))
+    if ok.sum() < 3 or np.unique(x[ok]).size < 2 or np.unique(y[ok]).size < 2:
+        return float("nan")  # undefined: a constant series or too few points
+    return float(stats.spearmanr(x[ok], y[ok]).statistic)
+
+
+def paper_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", night: str = "night") -> dict[str, bool | float]:
+    """Check the three findings on a sweep's tables (``sweep.csv``, ``od50.csv``).
+
+    Returns:
+        ``ap_falls_with_distance`` (bool) and ``ap_distance_rho_worst`` (the largest
+        per-camera rho in daylight; NaN rho counts as failing), ``night_below_day`` (bool),
+        ``night_minus_day_ap_max`` (largest night - day AP over cameras × distances where
+        not both are 0) and ``night_day_ties_at_zero`` (count), ``od50_rises_with_mtf50``
+        (bool) and ``od50_mtf50_rho`` (daylight, across cameras).
+    """
+    for name, frame, cols in (("table", table, ("camera", "condition", "distance_m", "ap")),
+                              ("od50", od50, ("camera", "condition", "mtf50_cy_per_mm", "od50_m"))):
+        missing = [c for c in cols if c not in frame.columns]
+        if missing:
+            raise ValueError(f"{name} lacks column(s) {missing}")
+    for condition in (day, night):
+        if condition not in set(table["condition"]):
+            raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
+
+    day_rows = table[table["condition"] == day]
+    rhos = [_spearman(part["distance_m"], part["ap"]) for _, part in day_rows.groupby("camera")]
+    worst = float(np.max(rhos)) if not np.any(np.isnan(rhos)) else float("nan")
+
+    paired = day_rows.merge(table[table["condition"] == night], on=["camera", "distance_m"], suffixes=("_day", "_night"))
+    if paired.empty:
+        raise ValueError(f"no camera × distance has both {day!r} and {night!r} AP")
+    both_zero = (paired["ap_day"] == 0) & (paired["ap_night"] == 0)
+    diff = (paired["ap_night"] - paired["ap_day"])[~both_zero]
+    diff_max = float(diff.max()) if len(diff) else float("nan")
+
+    od_day = od50[od50["condition"] == day]
+    rho_od = _spearman(od_day["mtf50_cy_per_mm"], od_day["od50_m"].astype(float).replace(np.inf, 1e12))
+    return {
+        "ap_falls_with_distance": bool(worst <= AP_DISTANCE_RHO_MAX),
+        "ap_distance_rho_worst": worst,
+        "night_below_day": bool(len(diff) > 0 and diff_max < 0),
+        "night_minus_day_ap_max": diff_max,
+        "night_day_ties_at_zero": int(both_zero.sum()),
+        "od50_rises_with_mtf50": bool(rho_od >= OD50_MTF50_RHO_MIN),
+        "od50_mtf50_rho": rho_od,
+    }
