@@ -64,3 +64,14 @@ def test_no_detections_bootstrap():
     gt, _ = synthetic_collection(4, seed=0)
     res = bootstrap_od50(gt, [], n_resamples=20)
     assert res["od50_m"] == 0.0 and res["sd_m"] == 0.0
+
+
+def test_percentile_interval_with_unreachable_od50():
+    import numpy as np
+
+    from benchmark.scoring.bootstrap import percentile_interval
+
+    values = np.r_[np.linspace(100.0, 199.0, 100), np.full(5, np.inf)]
+    lo, hi = percentile_interval(values, 0.95)
+    assert lo == 102.0 and hi == np.inf
+    assert percentile_interval(np.linspace(0, 100, 101), 0.9) == (5.0, 95.0)

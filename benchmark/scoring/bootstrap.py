@@ -193,7 +193,7 @@ def bootstrap_od50(
     )
     dist = np.asarray(res.bootstrap_distribution, dtype=np.float64)
     finite = dist[np.isfinite(dist)]
-    lo, hi = np.percentile(dist, [50 * (1 - confidence_level), 50 * (1 + confidence_level)], method="linear") if dist.size else (np.nan, np.nan)
+    lo, hi = percentile_interval(dist, confidence_level)
     return {
         "od50_m": float(point),
         "sd_m": float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
@@ -202,3 +202,15 @@ def bootstrap_od50(
         "n_environments": len(envs),
         "n_infinite": int(dist.size - finite.size),
     }
+
+
+def percentile_interval(values: np.ndarray, confidence_level: float = 0.95) -> tuple[float, float]:
+    """Percentile interval of a bootstrap distribution that may hold +inf (OD50 beyond
+    reach). The ends are order statistics rounded outwards, not interpolated, so an
+    infinite neighbour gives inf rather than inf - inf = NaN."""
+    values = np.asarray(values, dtype=np.float64)
+    if values.size == 0:
+        return (float("nan"), float("nan"))
+    tail = round(50.0 * (1.0 - confidence_level), 9)  # 50 * (1 - 0.9) is 4.999...; keep it 5
+    return (float(np.percentile(values, tail, method="lower")),
+            float(np.percentile(values, 100.0 - tail, method="higher")))
