@@ -68,8 +68,7 @@ def run(
     for row in results["per_distance"]:
         table.add_row(f"{row['distance_m']:g}", f"{row['ap']:.3f}", f"{row['ap50']:.3f}", str(row["n_images"]))
     console.print(table)
-    od50 = results["od50_m"]
-    console.print(f"OD50 = {od50:.1f} m" if od50 is not None else "OD50: undefined (AP never reaches 0.5)")
+    console.print(od50_text(results["od50_m"]))
     console.print(f"wrote {out / 'results.json'}")
 
 
@@ -156,6 +155,54 @@ def report(
     except (ValueError, OSError, KeyError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     console.print(f"wrote {page} (figures in {page.parent / 'figures'})")
+
+
+@app.command()
+def score(
+    results_dir: Annotated[Path, typer.Argument(help="a `benchmark run` folder")],
+    backend: Annotated[str, typer.Option(help="faster-coco-eval | pycocotools")] = "faster-coco-eval",
+    score_threshold: Annotated[float, typer.Option(min=0.0, max=1.0, help="working threshold for detection rates")] = 0.25,
+    iou: Annotated[float, typer.Option(min=0.0, max=1.0, help="IoU that counts as finding the car")] = 0.5,
+    as_json: Annotated[bool, typer.Option("--json")] = False,
+) -> None:
+    """Re-score a run from its detections: AP per distance, detection rates, what the car was taken for."""
+    import json
+
+    from benchmark.scoring import ap_by_distance, detection_rates, od50
+
+    try:
+        groundtruth = json.loads((results_dir / "groundtruth.json").read_text())
+        detections = json.loads((results_dir / "detections.json").read_text())
+        ap_rows = ap_by_distance(groundtruth, detections, backend=backend)
+    except FileNotFoundError as exc:
+        fail(f"{results_dir}: not a run folder ({Path(exc.filename).name} is missing)")
+    except (json.JSONDecodeError, ValueError, KeyError) as exc:
+        fail(f"{results_dir}: cannot score ({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})")
+    rates = detection_rates(groundtruth, detections, score_threshold=score_threshold, iou_threshold=iou)
+    rows = [{**a, **{k: r[k] for k in ("rate", "detected", "mistaken_for", "missed_scenes")}}
+            for a, r in zip(ap_rows, rates, strict=True)]
+    distance_od50 = od50([r["distance_m"] for r in rows], [r["ap"] for r in rows])
+    if as_json:
+        print(json.dumps({"backend": backend, "score_threshold": score_threshold, "iou_threshold": iou,
+                          "od50_m": distance_od50 if distance_od50 != float("inf") else None,
+                          "per_distance": rows}, indent=1))
+        return
+    table = Table(title=f"{results_dir} · {backend}")
+    for col in ("distance (m)", "AP", "AP50", f"found (score ≥ {score_threshold:g})", "taken for"):
+        table.add_column(col, justify="right")
+    for r in rows:
+        taken = ", ".join(f"{k} {v}" for k, v in r["mistaken_for"].items())
+        table.add_row(f"{r['distance_m']:g}", f"{r['ap']:.3f}", f"{r['ap50']:.3f}",
+                      f"{r['detected']}/{r['n_images']}", taken)
+    console.print(table)
+    console.print(od50_text(distance_od50))
+
+
+def od50_text(od50_m: float | None) -> str:
+    """OD50 for people; None or inf: AP does not fall to 0.5 (the extrapolation never crosses)."""
+    if od50_m is None or od50_m == float("inf"):
+        return "OD50: beyond reach (AP does not fall to 0.5 with distance)"
+    return f"OD50 = {od50_m:.1f} m"
 
 
 def main() -> None:

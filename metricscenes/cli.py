@@ -1,4 +1,4 @@
-"""``metricscenes`` command line: generate, verify, info, preview."""
+"""``metricscenes`` command line: generate, verify, info, preview, export, preview-assets."""
 
 from __future__ import annotations
 
@@ -179,6 +179,53 @@ def preview(
     except _user_errors() as exc:
         fail(str(exc))
     path = contact_sheet(tiles, labels, columns, out or collection / f"preview-{condition}.png")
+    console.print(f"wrote {path}")
+
+
+@app.command("export")
+def export_cmd(
+    collection: Annotated[Path, typer.Argument(help="collection folder")],
+    out: Annotated[Path, typer.Argument(help="file to write (e.g. scene.h5)")],
+    scene: Annotated[str, typer.Option("--scene", help="scene id, e.g. env000-d100m")],
+    condition: Annotated[str, typer.Option(help="condition, e.g. day")] = "day",
+    fmt: Annotated[str, typer.Option("--format", help="output format (hdf5: ISETCam-ready)")] = "hdf5",
+    width_px: Annotated[Optional[int], typer.Option(
+        "--width-px", help="export grid width (default: the inset's sampling over the field, at most 2688)")] = None,
+    gzip: Annotated[bool, typer.Option("--gzip", help="gzip the cubes (~25 % smaller, ~4x slower)")] = False,
+) -> None:
+    """Export one scene's composited radiance and photons (with wave, fov, distance, box) for ISETCam."""
+    from metricscenes.export import ExportError, export_scene
+
+    try:
+        path = export_scene(collection, scene, condition, fmt, out, width_px=width_px, gzip=gzip)
+    except (*_user_errors(), ExportError) as exc:
+        fail(str(exc))
+    console.print(f"wrote {path}")
+
+
+@app.command("preview-assets")
+def preview_assets_cmd(
+    kind: Annotated[str, typer.Argument(help="cars or skies")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="PNG to write")],
+    spp: Annotated[int, typer.Option(help="samples per pixel")] = 64,
+    seed: Annotated[int, typer.Option(help="sampler seed (tile i uses seed + i)")] = 0,
+    workers: Annotated[int, typer.Option(min=1, help="render processes")] = 1,
+    ids: Annotated[Optional[str], typer.Option(help="comma-separated asset ids (default: all)")] = None,
+    columns: Annotated[int, typer.Option(min=1)] = 10,
+) -> None:
+    """Render a labelled contact sheet of the 50 library cars or the 30 skies (docs/img/)."""
+    from metricscenes.preview_assets import AssetPreviewError, asset_contact_sheet
+
+    try:
+        chosen = None
+        if ids is not None:
+            try:
+                chosen = [int(i) for i in ids.split(",") if i.strip()]
+            except ValueError:
+                raise AssetPreviewError(f"--ids must be comma-separated integers, got {ids!r}") from None
+        path = asset_contact_sheet(kind, out, ids=chosen, spp=spp, seed=seed, workers=workers, columns=columns)
+    except (*_user_errors(), AssetPreviewError) as exc:
+        fail(str(exc))
     console.print(f"wrote {path}")
 
 

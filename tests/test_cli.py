@@ -51,3 +51,21 @@ def test_unknown_camera_and_collection_are_one_line(tmp_path):
     assert "cam99" in line
     line = _one_line_error(_run("metricscenes.cli", "info", tmp_path / "absent"))
     assert "absent" in line
+
+
+def test_score_rescores_a_run_folder(tmp_path):
+    from typer.testing import CliRunner
+
+    from benchmark.cli import app
+    from benchmark.scoring.synthetic import synthetic_collection
+
+    gt, dets = synthetic_collection(n_environments=4, seed=3)
+    (tmp_path / "groundtruth.json").write_text(json.dumps(gt))
+    (tmp_path / "detections.json").write_text(json.dumps(dets))
+    runner = CliRunner()
+    fast = json.loads(runner.invoke(app, ["score", str(tmp_path), "--json"]).output)
+    ref = json.loads(runner.invoke(app, ["score", str(tmp_path), "--json", "--backend", "pycocotools"]).output)
+    assert [r["ap"] for r in fast["per_distance"]] == pytest.approx([r["ap"] for r in ref["per_distance"]], abs=1e-12)
+    assert all(0 <= r["rate"] <= 1 for r in fast["per_distance"])
+    line = _one_line_error(_run("benchmark.cli", "score", tmp_path / "absent"))
+    assert "not a run folder" in line
