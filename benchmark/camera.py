@@ -96,6 +96,6 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
         height_px=camera.height_px,
         seed=int(seed),
         camera_sha256=camera.sha256(),
-        electrons=(rate * np.float32(exposure_s)).astype(np.float32),
+        electrons=np.multiply(rate, np.float32(exposure_s), dtype=np.float32),
         rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
     )

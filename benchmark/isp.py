@@ -2,8 +2,8 @@
 
 Order (as dcraw and most camera ISPs): black-level subtraction and normalisation →
 white-balance gains on the mosaic → demosaic (Malvar, He & Cutler 2004, ICASSP, by
-default; bilinear option; colour-demosaicing) → 3×3 colour matrix to linear sRGB →
-sRGB transfer curve (IEC 61966-2-1) → 8 bit.
+default, in float32 by :mod:`benchmark.demosaic`; bilinear option, colour-demosaicing)
+→ 3×3 colour matrix to linear sRGB → sRGB transfer curve (IEC 61966-2-1) → 8 bit.
 
 The colour matrix is fitted for each sensor by least squares on the 24 spectral
 reflectances of the ColorChecker (colour-science's ``ColorChecker N Ohta``) under
@@ -20,7 +20,8 @@ import colour_demosaicing
 import numpy as np
 
 from benchmark.cameras.spec import ISPSpec, SensorSpec
-from benchmark.sensor import cfa_index, channel_responsivity
+from benchmark.demosaic import malvar2004
+from benchmark.sensor import channel_responsivity
 from metricscenes.spectral import WAVELENGTHS_NM
 
 _CHECKER = "ColorChecker N Ohta"
@@ -34,8 +35,12 @@ def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
 
 def grey_world_gains(mosaic: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     """Gains (3,) making the R, G, B means of the mosaic equal (G gain 1)."""
-    idx = cfa_index(*mosaic.shape, cfa)
-    means = np.array([mosaic[idx == c].mean(dtype=np.float64) for c in range(3)])
+    sums, counts = np.zeros(3), np.zeros(3)
+    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
+        site = mosaic[dy::2, dx::2]
+        sums["RGB".index(ch)] += site.sum(dtype=np.float64)
+        counts["RGB".index(ch)] += site.size
+    means = sums / np.maximum(counts, 1)
     if np.any(means <= 0):
         return np.ones(3)
     return means[1] / means
@@ -64,9 +69,10 @@ def apply_gains(mosaic: np.ndarray, gains: np.ndarray, cfa: str = "RGGB") -> np.
 
 
 def demosaic(mosaic: np.ndarray, method: str = "malvar2004", cfa: str = "RGGB") -> np.ndarray:
-    """(rows, cols) mosaic → (rows, cols, 3) float32 RGB."""
+    """(rows, cols) mosaic → (rows, cols, 3) float32 RGB (``malvar2004``: the float32
+    implementation in :mod:`benchmark.demosaic`; ``bilinear``: colour-demosaicing)."""
     if method == "malvar2004":
-        rgb = colour_demosaicing.demosaicing_CFA_Bayer_Malvar2004(mosaic, cfa)
+        return malvar2004(mosaic, cfa)
     elif method == "bilinear":
         rgb = colour_demosaicing.demosaicing_CFA_Bayer_bilinear(mosaic, cfa)
     else:
@@ -140,7 +146,7 @@ def process(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec) -> np.ndarray:
     """Raw Bayer DN (rows, cols) → linear sRGB (rows, cols, 3) float32 (not clipped)."""
     rgb = white_balanced_rgb(raw_dn, sensor, isp)
     m = color_matrix(sensor).astype(np.float32)
-    return np.einsum("hwc,kc->hwk", rgb, m, optimize=True).astype(np.float32, copy=False)
+    return np.matmul(rgb, m.T)
 
 
 def white_balanced_rgb(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec) -> np.ndarray:

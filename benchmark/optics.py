@@ -19,12 +19,16 @@ symmetric reflection (``pad_px``, a few Airy radii) so the FFT does not wrap aro
 
 Sensor integration is linear in irradiance, so a colour channel's signal is
 ``Σ_λ r_c(λ) · E(λ)``: :func:`channel_signal` sums spectra in the frequency domain
-(one forward rFFT per band, one inverse per channel) — the fast path.
-:func:`irradiance` gives the plain per-band irradiance for tests.
+(one float32 forward rFFT per band, one inverse per channel) — the fast path. Its
+per-band OTFs are exact (no table), computed once per (grid, pixel, f-number, bands)
+and cached; bands are read as contiguous planes (:meth:`SpectralScene.resample` stores
+them so) and padded in place. :func:`irradiance` gives the plain per-band irradiance,
+the reference the fast path is tested against.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -33,6 +37,7 @@ import scipy.fft as sfft
 from benchmark.cameras.spec import OpticsSpec
 
 FFT_WORKERS = 2
+_BATCH = 8  # spectra summed per matrix product (memory: 8 × the padded image, complex64)
 
 
 def irradiance_per_radiance(f_number: float, transmittance: float = 1.0) -> float:
@@ -70,40 +75,59 @@ def otf_grid(shape_px: tuple[int, int], pixel_um: float, wavelength_nm: float, f
     return diffraction_mtf(np.hypot(fx, fy), wavelength_nm, f_number).astype(np.float32)
 
 
-class _RadialGrid:
-    """|ν| on an rFFT grid, for fast per-band OTF evaluation: the OTF depends on
-    ν·λ·N only, so it is read from a fine table (error < 1e-4) and only for the
-    non-negative vertical frequencies (the grid is symmetric in ν_y)."""
+@functools.lru_cache(maxsize=3)
+def _half_otfs(
+    shape_px: tuple[int, int], pixel_um: float, wavelengths_nm: tuple[float, ...], f_number: float
+) -> np.ndarray:
+    """Exact diffraction OTFs (bands, rows // 2 + 1, cols // 2 + 1), float32, on the
+    non-negative vertical frequencies of an rFFT grid (rows k and rows − k have the
+    same |ν_y|). Cached: a camera's every capture has the same grid and bands; a
+    sweep runs one camera at a time."""
+    rows, cols = shape_px
+    pixel_mm = pixel_um * 1e-3
+    fy = np.abs(sfft.fftfreq(rows, d=pixel_mm)[: rows // 2 + 1, None])
+    rho = np.hypot(sfft.rfftfreq(cols, d=pixel_mm)[None, :], fy)
+    out = np.stack([diffraction_mtf(rho, wl, f_number).astype(np.float32) for wl in wavelengths_nm])
+    out.setflags(write=False)
+    return out
 
-    _TABLE = diffraction_mtf(np.linspace(0.0, 1.0, 16385), 1.0, 1e6).astype(np.float32)
 
-    def __init__(self, shape_px: tuple[int, int], pixel_um: float):
-        rows, cols = shape_px
-        self.rows = rows
-        self.half = rows // 2 + 1
-        pixel_mm = pixel_um * 1e-3
-        fy = np.abs(sfft.fftfreq(rows, d=pixel_mm)[: self.half, None])
-        fx = sfft.rfftfreq(cols, d=pixel_mm)[None, :]
-        self.rho = np.hypot(fx, fy).astype(np.float32)
-        self.out = np.empty((rows, cols // 2 + 1), dtype=np.float32)
+def _apply_otf(spec: np.ndarray, half_otf: np.ndarray, out: np.ndarray) -> None:
+    """``out = spec × OTF`` on the full rFFT grid from the half-grid OTF."""
+    half = half_otf.shape[0]
+    rows = spec.shape[0]
+    np.multiply(spec[:half], half_otf, out=out[:half])
+    np.multiply(spec[half:], half_otf[1 : rows - half + 1][::-1], out=out[half:])
 
-    def mtf(self, wavelength_nm: float, f_number: float) -> np.ndarray:
-        n = len(self._TABLE) - 1
-        scale = np.float32(wavelength_nm * 1e-6 * f_number * n)
-        idx = np.multiply(self.rho, scale)
-        np.minimum(idx, n, out=idx)
-        np.add(idx, 0.5, out=idx)
-        top = self._TABLE.take(idx.astype(np.int32))
-        self.out[: self.half] = top
-        # rows k and rows - k have the same |ν_y|
-        self.out[self.half :] = top[1 : self.rows - self.half + 1][::-1]
-        return self.out
+
+def _pad_into(buf: np.ndarray, band: np.ndarray, pad: int) -> None:
+    """Write ``band`` into ``buf`` at (pad, pad) and fill the margins by symmetric
+    reflection: the same array as ``np.pad(band, ..., mode="symmetric")``, without
+    allocating one."""
+    rows, cols = band.shape
+    bottom, right = buf.shape[0] - rows - pad, buf.shape[1] - cols - pad
+    if max(pad, bottom) > rows or max(pad, right) > cols:  # margins wider than the image
+        buf[...] = np.pad(band, ((pad, bottom), (pad, right)), mode="symmetric")
+        return
+    inner = slice(pad, pad + cols)
+    buf[pad : pad + rows, inner] = band
+    buf[:pad, inner] = band[:pad][::-1]
+    buf[pad + rows :, inner] = band[rows - bottom :][::-1]
+    buf[:, :pad] = buf[:, pad : 2 * pad][:, ::-1]
+    buf[:, pad + cols :] = buf[:, pad + cols - right : pad + cols][:, ::-1]
 
 
 def _pad(band: np.ndarray, pad: int, shape: tuple[int, int]) -> np.ndarray:
     rows, cols = band.shape
     out = np.pad(band, ((pad, shape[0] - rows - pad), (pad, shape[1] - cols - pad)), mode="symmetric")
     return out
+
+
+def band_planes(radiance: np.ndarray) -> np.ndarray:
+    """(rows, cols, bands) radiance as (bands, rows, cols) C-contiguous planes: a view
+    when the cube is stored band by band (as :meth:`SpectralScene.resample` returns
+    it), else one copy."""
+    return np.ascontiguousarray(np.moveaxis(np.asarray(radiance, dtype=np.float32), 2, 0))
 
 
 def channel_signal(
@@ -118,7 +142,8 @@ def channel_signal(
     """Per-channel signal images from a radiance grid on the sensor's pixel grid.
 
     Args:
-        radiance: (rows, cols, bands) W·sr⁻¹·m⁻²·nm⁻¹, one sample per pixel.
+        radiance: (rows, cols, bands) W·sr⁻¹·m⁻²·nm⁻¹, one sample per pixel (fastest
+            when stored band by band, as :meth:`SpectralScene.resample` returns it).
         wavelengths_nm: (bands,) band centres.
         optics: the lens.
         pixel_um: pixel pitch, µm (sampling of ``radiance``).
@@ -130,32 +155,52 @@ def channel_signal(
         (channels, rows, cols) float32, e.g. electrons·s⁻¹.
     """
     rows, cols, bands = radiance.shape
+    planes = band_planes(radiance)
     resp = np.asarray(responsivity, dtype=np.float64) * irradiance_per_radiance(
         optics.f_number, optics.transmittance
     )
+    channels = resp.shape[0]
     if not diffraction:
-        out = np.einsum("hwb,cb->chw", radiance, resp.astype(np.float32), optimize=True)
+        out = np.matmul(resp.astype(np.float32), planes.reshape(bands, -1)).reshape(channels, rows, cols)
     else:
-        pad = pad_px(pixel_um, optics.f_number, float(np.max(wavelengths_nm)))
-        shape = _padded_shape(rows, cols, pad)
-        radial = _RadialGrid(shape, pixel_um)
-        acc = np.zeros((resp.shape[0], shape[0], shape[1] // 2 + 1), dtype=np.complex64)
-        tmp = np.empty_like(acc[0])
-        for b in range(bands):
-            if not np.any(resp[:, b]):
-                continue
-            spec = sfft.rfft2(_pad(radiance[:, :, b], pad, shape), workers=FFT_WORKERS)
-            spec *= radial.mtf(float(wavelengths_nm[b]), optics.f_number)
-            for c in range(resp.shape[0]):
-                np.multiply(spec, np.float32(resp[c, b]), out=tmp)
-                acc[c] += tmp
-        out = np.empty((resp.shape[0], rows, cols), dtype=np.float32)
-        for c in range(resp.shape[0]):
-            full = sfft.irfft2(acc[c], s=shape, workers=FFT_WORKERS)
-            out[c] = full[pad : pad + rows, pad : pad + cols]
+        out = _diffracted_channels(planes, np.asarray(wavelengths_nm, float), optics.f_number, pixel_um, resp)
     if optics.cos4_falloff:
         out *= cos4_map(rows, cols, pixel_um, optics.focal_length_mm)[None]
-    return out.astype(np.float32, copy=False)
+    return out
+
+
+def _diffracted_channels(
+    planes: np.ndarray, wavelengths_nm: np.ndarray, f_number: float, pixel_um: float, resp: np.ndarray
+) -> np.ndarray:
+    """Σ_b resp[c, b] · OTF_b · FFT(band b), one inverse FFT per channel.
+
+    Bands go through the FFT one at a time into a batch of OTF-weighted spectra; each
+    full batch is added to the channel spectra by one matrix product (channels × batch)
+    over the spectra viewed as float32 (the weights are real).
+    """
+    bands, rows, cols = planes.shape
+    channels = resp.shape[0]
+    pad = pad_px(pixel_um, f_number, float(np.max(wavelengths_nm)))
+    shape = _padded_shape(rows, cols, pad)
+    otfs = _half_otfs(shape, float(pixel_um), tuple(float(w) for w in wavelengths_nm), float(f_number))
+    used = [b for b in range(bands) if np.any(resp[:, b])]
+    spec_shape = (shape[0], shape[1] // 2 + 1)
+    batch = np.empty((min(_BATCH, max(len(used), 1)),) + spec_shape, dtype=np.complex64)
+    acc = np.zeros((channels,) + spec_shape, dtype=np.complex64)
+    acc_f = acc.view(np.float32).reshape(channels, -1)
+    batch_f = batch.view(np.float32).reshape(batch.shape[0], -1)
+    padded = np.empty(shape, dtype=np.float32)
+    for start in range(0, len(used), batch.shape[0]):
+        chunk = used[start : start + batch.shape[0]]
+        for k, b in enumerate(chunk):
+            _pad_into(padded, planes[b], pad)
+            _apply_otf(sfft.rfft2(padded, workers=FFT_WORKERS), otfs[b], batch[k])
+        weights = resp[:, chunk].astype(np.float32)
+        acc_f += weights @ batch_f[: len(chunk)]
+    out = np.empty((channels, rows, cols), dtype=np.float32)
+    for c in range(channels):
+        out[c] = sfft.irfft2(acc[c], s=shape, workers=FFT_WORKERS)[pad : pad + rows, pad : pad + cols]
+    return out
 
 
 def irradiance(
@@ -183,10 +228,14 @@ def _one_band(band: np.ndarray, wavelength_nm: float, optics: OpticsSpec, pixel_
     return out
 
 
+@functools.lru_cache(maxsize=4)
 def cos4_map(rows: int, cols: int, pixel_um: float, focal_length_mm: float) -> np.ndarray:
-    """Relative illumination cos⁴θ of each pixel centre (natural vignetting)."""
+    """Relative illumination cos⁴θ of each pixel centre (natural vignetting); cached,
+    read-only."""
     pixel_mm = pixel_um * 1e-3
     y = (np.arange(rows) - (rows - 1) / 2.0) * pixel_mm / focal_length_mm
     x = (np.arange(cols) - (cols - 1) / 2.0) * pixel_mm / focal_length_mm
     tan2 = y[:, None] ** 2 + x[None, :] ** 2
-    return (1.0 / (1.0 + tan2) ** 2).astype(np.float32)
+    out = (1.0 / (1.0 + tan2) ** 2).astype(np.float32)
+    out.setflags(write=False)
+    return out

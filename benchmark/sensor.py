@@ -92,10 +92,18 @@ def mosaic(channels: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
 
 
 def fixed_pattern(sensor: SensorSpec, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """PRNU gain map (mean 1) and DSNU offset map (V) of this sensor unit (``fpn_seed``)."""
-    rng = np.random.default_rng([sensor.fpn_seed, 0x5E45])
-    gain = 1.0 + sensor.prnu_fraction * rng.standard_normal(shape, dtype=np.float32)
-    offset = sensor.dsnu_v * rng.standard_normal(shape, dtype=np.float32)
+    """PRNU gain map (mean 1) and DSNU offset map (V) of this sensor unit (``fpn_seed``);
+    float32, read-only (cached: every capture of the unit has the same maps)."""
+    return _fixed_pattern(sensor.fpn_seed, sensor.prnu_fraction, sensor.dsnu_v, tuple(int(n) for n in shape))
+
+
+@functools.lru_cache(maxsize=4)
+def _fixed_pattern(fpn_seed: int, prnu_fraction: float, dsnu_v: float, shape: tuple[int, int]):
+    rng = np.random.default_rng([fpn_seed, 0x5E45])
+    gain = 1.0 + prnu_fraction * rng.standard_normal(shape, dtype=np.float32)
+    offset = dsnu_v * rng.standard_normal(shape, dtype=np.float32)
+    gain.setflags(write=False)
+    offset.setflags(write=False)
     return gain, offset
 
 
@@ -113,26 +121,40 @@ def capture_volts(
         exposure_s: integration time, s.
         rng: temporal-noise generator (needed when shot or read noise is on).
     """
-    electrons = electron_rate.astype(np.float64) * exposure_s
+    # float64 throughout, in place: the same values (and random draws) as the plain
+    # expressions, without a temporary per step.
+    electrons = np.multiply(electron_rate, exposure_s, dtype=np.float64)
     if noise.dark and sensor.dark_current_e_per_s > 0:
-        electrons = electrons + sensor.dark_current_e_per_s * exposure_s
+        electrons += sensor.dark_current_e_per_s * exposure_s
     if noise.shot:
-        electrons = rng.poisson(np.maximum(electrons, 0.0)).astype(np.float64)
-    electrons = np.minimum(electrons, sensor.well_capacity_e)  # the photodiode's well
+        np.maximum(electrons, 0.0, out=electrons)
+        # Poisson counts, then the photodiode's well
+        np.minimum(rng.poisson(electrons), sensor.well_capacity_e, out=electrons, casting="unsafe")
+    else:
+        np.minimum(electrons, sensor.well_capacity_e, out=electrons)  # the photodiode's well
     if noise.read and sensor.read_noise_e > 0:
-        electrons = electrons + sensor.read_noise_e * rng.standard_normal(electrons.shape)
-    volts = electrons * (sensor.conversion_gain_uv_per_e * 1e-6)
+        read = rng.standard_normal(electrons.shape)
+        read *= sensor.read_noise_e
+        electrons += read
+    volts = electrons
+    volts *= sensor.conversion_gain_uv_per_e * 1e-6
     if (noise.prnu and sensor.prnu_fraction > 0) or (noise.dsnu and sensor.dsnu_v > 0):
         gain, offset = fixed_pattern(sensor, volts.shape)
-        volts = volts * (gain if noise.prnu else 1.0) + (offset if noise.dsnu else 0.0)
-    volts = volts * sensor.analog_gain + sensor.black_level_dn * sensor.lsb_v
-    return np.clip(volts, 0.0, sensor.voltage_swing_v)
+        if noise.prnu:
+            volts *= gain
+        if noise.dsnu:
+            volts += offset
+    volts *= sensor.analog_gain
+    volts += sensor.black_level_dn * sensor.lsb_v
+    return np.clip(volts, 0.0, sensor.voltage_swing_v, out=volts)
 
 
 def quantize(volts: np.ndarray, sensor: SensorSpec) -> np.ndarray:
     """Linear ADC: DN = round(V / LSB), uint16 in [0, 2^bits − 1]."""
-    dn = np.rint(volts / sensor.lsb_v)
-    return np.clip(dn, 0, sensor.white_level_dn).astype(np.uint16)
+    dn = np.divide(volts, sensor.lsb_v)
+    np.rint(dn, out=dn)
+    np.clip(dn, 0, sensor.white_level_dn, out=dn)
+    return dn.astype(np.uint16)
 
 
 def capture_dn(

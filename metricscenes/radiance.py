@@ -77,20 +77,37 @@ class SpectralScene:
         flux is conserved); where it is coarser, values are interpolated linearly
         between sample centres. A uniform field stays uniform either way.
         ``extent`` defaults to the plate's (the full field of view).
+
+        The array is stored band by band (a (bands, rows, cols) C-contiguous block
+        viewed as (rows, cols, bands)), so each band ``out[:, :, b]`` is one contiguous
+        image, as the per-band optics wants it.
         """
         extent = extent or self.extent
         out = _apply(*_weights(self.layers[0], cols, rows, extent), self.layers[0].radiance)
         for inset in self.layers[1:]:
-            # Where the inset covers a target pixel, its radiance replaces the plate's;
-            # partly covered pixels blend by covered area.
-            cover_x = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
-                                      extent.x0, extent.x1, cols)
-            cover_y = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
-                                      extent.y0, extent.y1, rows)
-            coverage = np.outer(np.asarray(cover_y.sum(axis=1)).ravel(), np.asarray(cover_x.sum(axis=1)).ravel())
-            values = _apply(*_weights(inset, cols, rows, extent), inset.radiance)
-            out = out * (1.0 - coverage[..., None]).astype(np.float32) + values * coverage[..., None].astype(np.float32)
-        return out
+            _paste(out, inset, cols, rows, extent)
+        return out.transpose(1, 2, 0)
+
+
+def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> None:
+    """Paste ``inset`` over band planes ``out`` (bands, rows, cols) in place: where the
+    inset covers a target pixel its radiance replaces the plate's; partly covered pixels
+    blend by covered area. Only the window the inset touches is computed."""
+    cover_x = np.asarray(_overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
+                                         extent.x0, extent.x1, cols).sum(axis=1)).ravel()
+    cover_y = np.asarray(_overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
+                                         extent.y0, extent.y1, rows).sum(axis=1)).ravel()
+    jx, iy = np.flatnonzero(cover_x > 0), np.flatnonzero(cover_y > 0)
+    if jx.size == 0 or iy.size == 0:
+        return
+    x_win, y_win = slice(jx[0], jx[-1] + 1), slice(iy[0], iy[-1] + 1)
+    wy, wx = _weights(inset, cols, rows, extent)
+    values = _apply(wy[y_win], wx[x_win], inset.radiance)
+    coverage = np.outer(cover_y[y_win], cover_x[x_win])
+    window = out[:, y_win, x_win]
+    window *= (1.0 - coverage).astype(np.float32)
+    values *= coverage.astype(np.float32)
+    window += values
 
 
 def _weights(layer: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> tuple[sp.csr_matrix, sp.csr_matrix]:
@@ -130,11 +147,39 @@ def _linear_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: floa
 
 
 def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, cube: np.ndarray) -> np.ndarray:
+    """Resample a (rows_in, cols_in, bands) cube to band planes (bands, rows, cols),
+    float32: columns first, by gathering each output column's few source columns
+    (at the layer's row count), then rows, by one sparse product over all bands."""
     rows_in, cols_in, bands = cube.shape
-    tmp = wy @ cube.reshape(rows_in, cols_in * bands)  # (rows, cols_in*bands)
-    tmp = tmp.reshape(-1, cols_in, bands).transpose(1, 0, 2).reshape(cols_in, -1)
-    out = (wx @ tmp).reshape(wx.shape[0], -1, bands).transpose(1, 0, 2)
-    return np.ascontiguousarray(out, dtype=np.float32)
+    planes = np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
+    idx, val = _taps(wx)
+    tmp = np.take(planes, idx[:, 0], axis=2)
+    tmp *= val[:, 0]
+    for t in range(1, idx.shape[1]):
+        term = np.take(planes, idx[:, t], axis=2)
+        term *= val[:, t]
+        tmp += term
+    # Rows: a block-diagonal sparse matrix (one wy block per band) on (bands·rows_in, cols).
+    wy_all = sp.kron(sp.identity(bands, dtype=np.float32, format="csr"), wy.astype(np.float32), format="csr")
+    out = wy_all @ tmp.reshape(bands * rows_in, -1)
+    return np.asarray(out, dtype=np.float32).reshape(bands, wy.shape[0], -1)
+
+
+def _taps(w: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """A sparse (n_dst, n_src) matrix as (n_dst, taps) source indices and float32
+    weights (unused taps: index 0, weight 0)."""
+    w = sp.csr_matrix(w)
+    w.sort_indices()
+    counts = np.diff(w.indptr)
+    taps = max(int(counts.max(initial=0)), 1)
+    idx = np.zeros((w.shape[0], taps), dtype=np.intp)
+    val = np.zeros((w.shape[0], taps), dtype=np.float32)
+    for t in range(taps):
+        has = counts > t
+        pos = w.indptr[:-1][has] + t
+        idx[has, t] = w.indices[pos]
+        val[has, t] = w.data[pos]
+    return idx, val
 
 
 def _overlap_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: float, n_dst: int) -> sp.csr_matrix:

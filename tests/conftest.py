@@ -15,6 +15,11 @@ def model_dir() -> Path:
     return Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
 
 
+# Registry names resolve in METRICSCENES_MODEL_DIR: default it to the shared folder beside
+# the checkout, so tests that use a registry name skip or pass the same way as the rest.
+os.environ.setdefault("METRICSCENES_MODEL_DIR", str(model_dir()))
+
+
 def require_model(name: str) -> Path:
     path = model_dir() / name
     if not path.is_file():
