@@ -15,6 +15,8 @@ def test_spectrum_is_held_out_to_the_end_bands():
     assert np.interp(397, wl, val) == pytest.approx(0.2) and np.interp(703, wl, val) == pytest.approx(0.8)
     wide_wl, _ = _table(spectrum([350, 800], [1, 1]))
     np.testing.assert_array_equal(wide_wl, [350, 800])
+    band_wl, _ = _table(spectrum([395, 405], [0.1, 0.1], hold_ends=False))  # a film band stays a band
+    np.testing.assert_array_equal(band_wl, [395, 405])
 
 
 def test_end_band_radiance_is_not_halved():

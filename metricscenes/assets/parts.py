@@ -56,9 +56,12 @@ class SceneParts:
         return SceneParts(shapes={**self.shapes, **other.shapes}, lamps=self.lamps + other.lamps)
 
 
-def spectrum(wavelengths_nm, values) -> dict:
-    """Mitsuba ``irregular`` spectrum dict from wavelengths (nm, increasing) and values;
-    a table that stops inside 380-720 nm is held constant out to those ends."""
+def spectrum(wavelengths_nm, values, hold_ends: bool = True) -> dict:
+    """Mitsuba ``irregular`` spectrum dict from wavelengths (nm, increasing) and values.
+
+    With ``hold_ends`` (reflectances, emission), a table that stops inside 380-720 nm
+    is held constant out to those ends; a band-pass filter passes ``hold_ends=False``.
+    """
     wl = np.asarray(wavelengths_nm, dtype=float).ravel()
     val = np.asarray(values, dtype=float).ravel()
     if wl.shape != val.shape or wl.size < 2:
@@ -67,9 +70,9 @@ def spectrum(wavelengths_nm, values) -> dict:
         raise ValueError("spectrum wavelengths_nm must be strictly increasing")
     # Mitsuba reads an irregular spectrum as zero outside its table, and the end bands
     # span 395-405 and 695-705 nm: hold the end values out to 380 and 720 nm.
-    if wl[0] > SPECTRUM_PAD_NM[0]:
+    if hold_ends and wl[0] > SPECTRUM_PAD_NM[0]:
         wl, val = np.r_[SPECTRUM_PAD_NM[0], wl], np.r_[val[0], val]
-    if wl[-1] < SPECTRUM_PAD_NM[1]:
+    if hold_ends and wl[-1] < SPECTRUM_PAD_NM[1]:
         wl, val = np.r_[wl, SPECTRUM_PAD_NM[1]], np.r_[val, val[-1]]
     return {
         "type": "irregular",

@@ -219,7 +219,7 @@ def _specfilm(width: int, height: int) -> dict:
     """31 box bands of 10 nm (band-averaged radiance), zero-padded names, box filter."""
     film = {"type": "specfilm", "width": width, "height": height, "rfilter": {"type": "box"}}
     for c in WAVELENGTHS_NM:
-        film[f"b{int(c):04d}"] = spectrum([c - 5.0, c + 5.0], [0.1, 0.1])
+        film[f"b{int(c):04d}"] = spectrum([c - 5.0, c + 5.0], [0.1, 0.1], hold_ends=False)
     return film
 
 
