@@ -11,10 +11,8 @@ from pathlib import Path
 
 import jsonschema
 import pytest
-import typer
 from typer.testing import CliRunner
 
-from benchmark.cli_leaderboard import register
 from benchmark.leaderboard import (
     SubmissionError,
     build_submission,
@@ -28,27 +26,14 @@ from benchmark.leaderboard import (
 )
 from benchmark.leaderboard.synthetic import write_synthetic_run
 
+from leaderboard_support import PROTOCOLS, leaderboard_app
+
 REPO = Path(__file__).resolve().parents[1]
-PROTOCOLS = """protocols:
-  smoke:
-    description: smoke
-    manifests_sha256: [{sha}]
-    distances_m: [25, 50, 75, 100, 150, 200]
-    conditions: [day, night]
-    required_conditions: [day]
-"""
 
 
 @pytest.fixture(scope="module")
 def app():
-    app = typer.Typer()
-    register(app)
-
-    @app.callback()
-    def main():
-        pass
-
-    return app
+    return leaderboard_app()
 
 
 @pytest.fixture(scope="module")

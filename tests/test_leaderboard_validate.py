@@ -10,10 +10,8 @@ import math
 from pathlib import Path
 
 import pytest
-import typer
 from typer.testing import CliRunner
 
-from benchmark.cli_leaderboard import register
 from benchmark.leaderboard import (
     build_submission,
     check_submission_file,
@@ -26,28 +24,15 @@ from benchmark.leaderboard import (
 from benchmark.leaderboard.synthetic import write_synthetic_run
 from benchmark.scoring import od50
 
+from leaderboard_support import PROTOCOLS, leaderboard_app
+
 REPO = Path(__file__).resolve().parents[1]
 CREATED = "2025-01-02T03:04:05Z"
-PROTOCOLS = """protocols:
-  smoke:
-    description: smoke
-    manifests_sha256: [{sha}]
-    distances_m: [25, 50, 75, 100, 150, 200]
-    conditions: [day, night]
-    required_conditions: [day]
-"""
 
 
 @pytest.fixture(scope="module")
 def app():
-    app = typer.Typer()
-    register(app)
-
-    @app.callback()  # keep the commands subcommands, as in the lead's CLI
-    def main():
-        pass
-
-    return app
+    return leaderboard_app()
 
 
 @pytest.fixture(scope="module")

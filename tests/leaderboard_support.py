@@ -1,0 +1,28 @@
+"""Shared by the leaderboard tests: a leaderboard's accepted-protocol file and the CLI app."""
+
+from __future__ import annotations
+
+import typer
+
+from benchmark.cli_leaderboard import register
+
+PROTOCOLS = """protocols:
+  smoke:
+    description: smoke
+    manifests_sha256: [{sha}]
+    distances_m: [25, 50, 75, 100, 150, 200]
+    conditions: [day, night]
+    required_conditions: [day]
+"""
+
+
+def leaderboard_app() -> typer.Typer:
+    """The leaderboard commands on their own app (a callback keeps them subcommands, as in `benchmark`)."""
+    app = typer.Typer()
+    register(app)
+
+    @app.callback()
+    def main():
+        pass
+
+    return app
