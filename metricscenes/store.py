@@ -238,7 +238,7 @@ class Collection:
             raise CollectionError(f"{self.root}: {path} is missing from {RADIANCE_STORE}")
         node = group[path]
         total, extent = None, None
-        for light_group in node.array_keys():
+        for light_group in sorted(node.array_keys()):  # a fixed order: float sums are not associative
             arr = node[light_group]
             extent = TanExtent(*arr.attrs["extent_tan"])
             w = weights.get(light_group, 0.0)
@@ -249,7 +249,7 @@ class Collection:
         if extent is None:
             return None
         if total is None:
-            arr = node[next(iter(node.array_keys()))]
+            arr = node[min(node.array_keys())]
             total = np.zeros(arr.shape, dtype=np.float32)
         return RadianceLayer(total, extent)
 
