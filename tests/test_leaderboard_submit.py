@@ -299,3 +299,21 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     html = (lb / "index.html").read_text()
     assert 'href="submissions/cam01-yolov5n-smoke.json"' in html and f">{expected}" in html
     assert math.isclose(float(cells[6]), 4.2) and math.isclose(float(cells[7]), 3.1)  # pixel pitch, f-number
+
+
+def test_committed_reference_submissions_are_valid_and_rendered():
+    """The reference submissions in leaderboard/ still pass every check against the
+    packaged protocols (a manifest change must come with new references), and the
+    committed table is what `benchmark leaderboard` renders from them."""
+    from benchmark.leaderboard import check_submission_file, load_protocols, load_submissions, render_html, render_markdown
+
+    folder = REPO / "leaderboard"
+    subs = sorted((folder / "submissions").glob("*.json"))
+    assert len(subs) >= 13
+    for path in subs:
+        data = check_submission_file(path)
+        assert data["collection"]["protocol"] in {"quick", "metric-300"}
+    protocols = load_protocols(folder)
+    submissions = load_submissions(folder, protocols)
+    assert render_markdown(submissions, protocols) == (folder / "README.md").read_text()
+    assert render_html(submissions, protocols) == (folder / "index.html").read_text()
