@@ -159,8 +159,11 @@ def fit_line(x, y) -> tuple[float, float]:
 
 
 def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title: str | None = None):
-    """OD50 ± SD (bootstrap over environments) against MTF50, per condition, with a fitted
-    line whose slope (m per cycle/mm) is in the legend (paper Fig. 7A).
+    """OD50 against MTF50, per condition, with a fitted line whose slope (m per cycle/mm)
+    is in the legend (paper Fig. 7A). Error bars are the 95 % bootstrap interval when the
+    table has it (``ci95_lo_m``, ``ci95_hi_m``): OD50 extrapolated beyond the measured
+    distances has a skewed, unbounded spread that a symmetric ± SD bar misdraws (below
+    0 m); an unbounded upper end is drawn to the top of the axes. Otherwise ± SD.
 
     ``od50_table``: columns ``condition, mtf50_cy_per_mm, od50_m, sd_m`` (``od50.csv``).
     Infinite OD50s (AP never falls to 0.5) are left out of the plot and the fit.
@@ -174,17 +177,37 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
         slope, intercept = fit_line(part["mtf50_cy_per_mm"], part["od50_m"])
         label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}"
-        ax.errorbar(part["mtf50_cy_per_mm"], part["od50_m"], yerr=part["sd_m"].fillna(0.0), fmt="o", color=colour,
-                    capsize=3, label=label)
+        ax.errorbar(part["mtf50_cy_per_mm"], part["od50_m"], yerr=_error_bars(part, od50_table), fmt="o",
+                    color=colour, capsize=3, label=label)
         if np.isfinite(slope):
             xs = np.linspace(part["mtf50_cy_per_mm"].min(), part["mtf50_cy_per_mm"].max(), 2)
             ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
-    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", title=title or "OD50 vs MTF50 (± bootstrap SD)")
+    interval = {"ci95_lo_m", "ci95_hi_m"} <= set(od50_table.columns)
+    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", ylim=(0, _axis_top(od50_table)),
+           title=title or ("OD50 vs MTF50 (95 % bootstrap interval)" if interval else "OD50 vs MTF50 (± bootstrap SD)"))
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     if out is not None:
         save_figure(fig, out)
     return fig
+
+
+def _axis_top(table: pd.DataFrame) -> float:
+    finite = table["od50_m"].astype(float)
+    finite = finite[np.isfinite(finite)]
+    return 1.6 * float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+
+
+def _error_bars(part: pd.DataFrame, table: pd.DataFrame) -> np.ndarray:
+    """(2, n) lower/upper bar lengths: the 95 % interval if present, else ± SD."""
+    od50 = part["od50_m"].astype(float).to_numpy()
+    if {"ci95_lo_m", "ci95_hi_m"} <= set(part.columns):
+        top = _axis_top(table)
+        lo = np.clip(part["ci95_lo_m"].astype(float).to_numpy(), 0.0, None)
+        hi = np.minimum(part["ci95_hi_m"].astype(float).to_numpy(), top)
+        return np.nan_to_num(np.stack([od50 - lo, np.maximum(hi - od50, 0.0)]))
+    sd = part["sd_m"].astype(float).fillna(0.0).to_numpy()
+    return np.stack([np.minimum(sd, od50), sd])
 
 
 def _require(table: pd.DataFrame, columns) -> None:

@@ -1,0 +1,46 @@
+"""The paper's qualitative findings, checked on the table the quick sweep produced
+(docs/data/sweep.csv and od50.csv, written by the commands in docs/results.md)."""
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from benchmark.acceptance import paper_findings
+
+DATA = Path(__file__).resolve().parents[1] / "docs" / "data"
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return pd.read_csv(DATA / "sweep.csv"), pd.read_csv(DATA / "od50.csv")
+
+
+def test_the_table_covers_13_cameras_day_and_night(tables):
+    table, od50 = tables
+    assert table["camera"].nunique() == 13 and set(table["condition"]) == {"day", "night"}
+    assert len(table) == 13 * 2 * 6 and (table["n_images"] == 10).all()
+    assert len(od50) == 26
+
+
+def test_night_ap_is_below_day_ap_at_every_distance(tables):
+    assert paper_findings(*tables)["night_below_day"]
+
+
+def test_od50_rises_with_mtf50_in_daylight(tables):
+    findings = paper_findings(*tables)
+    assert findings["od50_rises_with_mtf50"] and findings["od50_mtf50_rho"] >= 0.6
+
+
+def test_far_cars_score_lower_than_near_cars_for_every_camera(tables):
+    day = tables[0][tables[0]["condition"] == "day"]
+    for camera, rows in day.groupby("camera"):
+        ap = rows.set_index("distance_m")["ap"]
+        assert ap[200.0] < ap[25.0], camera
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "On quick (10 environments) the six finest cameras keep AP ≈ 0.87 out to 100 m, so the "
+    "per-camera Spearman rho of AP vs distance is only -0.54 to -0.77 for them (docs/results.md)"))
+def test_ap_falls_with_distance_for_every_camera(tables):
+    assert paper_findings(*tables)["ap_falls_with_distance"]
