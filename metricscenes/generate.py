@@ -85,7 +85,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     """Render and write one unit (runs in a worker process); return its progress record."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
-    from metricscenes.render import Film, RenderError, illuminance_meter, render_depth, render_radiance, use_variant
+    from metricscenes.render import Film, illuminance_meter, render_radiance, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
     use_variant(manifest.render.variant, threads)
@@ -96,50 +96,68 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     record: dict = {"unit": unit.key, "kind": unit.kind, "arrays": {}}
     started = time.perf_counter()
     if unit.kind == "plate":
-        film, spp, kind, groups = Film(ref_w, ref_h), manifest.render.plate_spp, "plates", [
-            g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
-        extent = REFERENCE_EXTENT
+        groups = [g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
+        jobs = [("plates", g, Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT) for g in groups]
     else:
-        pose = scene_mod.car_pose(env, unit.distance_m)
         env_parts = parts
+        pose = scene_mod.car_pose(env, unit.distance_m)
         parts = parts.merged(scene_mod.car_parts(env, pose))
-        box = car_box_tan(scene_mod.car_vertices(env, pose))
-        k, cx, cy, cw, ch = inset_window(box, manifest)
-        film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch)
-        spp, kind, groups = manifest.render.inset_spp, "insets", list(manifest.light_groups)
-        e = REFERENCE_EXTENT
-        extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
-                           e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
-        # Instance mask: the rays whose first hit moves when the car is added.
-        depth_with, depth_without = (
-            render_depth(scene_mod.scene_dict(env, p, groups[0], film, spp=1, seed=unit.seed, max_depth=2), film)
-            for p in (parts, env_parts))
-        mask = (depth_with > 0) & (depth_with != depth_without)
-        mask_box = mask_box_tan(mask, extent)
-        if mask_box is None:
-            raise RenderError(f"{unit.key}: the car is not visible in its inset")
-        write_mask(root, unit.key, mask, extent)
-        record.update(box_tan=list(mask_box), projected_box_tan=list(box), mask_iou=round(box_iou(mask_box, box), 4),
-                      inset_scale=k, pose=asdict(pose), bbox_xywh=box_tan_to_xywh(mask_box, ref_w, ref_h))
-    jobs = [(kind, group, film, spp, extent) for group in groups]
-    if unit.kind == "inset" and "car_lights" in groups:
-        # The car's lamps light the road far outside its inset (an oncoming car's beams
-        # reach the camera): that group also gets a whole frame at plate sampling.
-        jobs.append(("frames", "car_lights", Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT))
-    for i, (job_kind, group, job_film, job_spp, job_extent) in enumerate(jobs):
+        film, extent = _inset_film(manifest, scene_mod.car_vertices(env, pose), record)
+        record.update(pose=asdict(pose), **_ground_truth(manifest, unit, root, env_parts, parts, film, extent, record))
+        jobs = [("insets", g, film, manifest.render.inset_spp, extent) for g in manifest.light_groups]
+        if "car_lights" in manifest.light_groups:
+            # The car's lamps light the road far outside its inset (an oncoming car's beams
+            # reach the camera): that group also gets a whole frame at plate sampling.
+            jobs.append(("frames", "car_lights", Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT))
+    for i, (kind, group, film, spp, extent) in enumerate(jobs):
         if not scene_mod.has_emitters(parts, group):
             continue
-        sd = scene_mod.scene_dict(env, parts, group, job_film, spp=job_spp, seed=unit.seed + 7919 * i,
+        sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
                                   max_depth=manifest.render.max_depth)
-        cube = render_radiance(sd, job_spp)
-        sha = write_radiance(root, job_kind, unit.key, group, cube, job_extent,
-                             {"spp": job_spp, "seed": unit.seed})
-        record["arrays"][f"{job_kind}/{unit.key}/{group}"] = sha
+        sha = write_radiance(root, kind, unit.key, group, render_radiance(sd, spp), extent,
+                             {"spp": spp, "seed": unit.seed})
+        record["arrays"][f"{kind}/{unit.key}/{group}"] = sha
         if unit.kind == "plate":
             irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)
             record.setdefault("illuminance_lux", {})[group] = round(float(radiance_to_xyz(irradiance)[1]), 9)
     record["seconds"] = round(time.perf_counter() - started, 3)
     return record
+
+
+def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray, record: dict):
+    """The inset's film (a crop of a k-times finer reference film) and its extent in
+    tangent coordinates; records the projected car box and k."""
+    from metricscenes.render import Film
+
+    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    box = car_box_tan(car_vertices_m)
+    k, cx, cy, cw, ch = inset_window(box, manifest)
+    film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch)
+    e = REFERENCE_EXTENT
+    extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
+                       e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
+    record.update(projected_box_tan=list(box), inset_scale=k)
+    return film, extent
+
+
+def _ground_truth(manifest: Manifest, unit: Unit, root: Path, env_parts, parts, film, extent, record: dict) -> dict:
+    """Instance mask (the rays whose first hit moves when the car is added), written to
+    the store; returns the mask box and its agreement with the projected mesh box."""
+    from metricscenes import scene as scene_mod
+    from metricscenes.render import RenderError, render_depth
+
+    group = manifest.light_groups[0]
+    depth_with, depth_without = (
+        render_depth(scene_mod.scene_dict(unit.environment, p, group, film, spp=1, seed=unit.seed, max_depth=2), film)
+        for p in (parts, env_parts))
+    mask = (depth_with > 0) & (depth_with != depth_without)
+    mask_box = mask_box_tan(mask, extent)
+    if mask_box is None:
+        raise RenderError(f"{unit.key}: the car is not visible in its inset")
+    write_mask(root, unit.key, mask, extent)
+    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    return {"box_tan": list(mask_box), "mask_iou": round(box_iou(mask_box, record["projected_box_tan"]), 4),
+            "bbox_xywh": box_tan_to_xywh(mask_box, ref_w, ref_h)}
 
 
 def _progress_path(root: Path, key: str) -> Path:
