@@ -33,11 +33,37 @@ def use_variant(variant: str = "scalar_spectral", threads: int | None = None):
     if _active_variant != variant:
         if variant not in mi.variants():
             raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
+        if variant.startswith("llvm"):
+            _probe_llvm(variant)
         mi.set_variant(variant)
         _active_variant = variant
     if threads is not None:
         dr.set_thread_count(max(1, int(threads)))
     return mi
+
+
+_LLVM_PROBE = """
+import mitsuba as mi
+mi.set_variant({variant!r})
+scene = mi.load_dict({{"type": "scene", "sensor": {{"type": "perspective", "film": {{"type": "hdrfilm",
+    "width": 2, "height": 2}}}}, "light": {{"type": "constant"}}}})
+mi.render(scene, spp=1)
+"""
+
+
+def _probe_llvm(variant: str) -> None:
+    """Render 2x2 pixels with an LLVM variant in a child process first: with a libLLVM
+    older than 17 (Debian 12's default is 15) the first render aborts the whole process
+    (``LLVM ERROR: Cannot select ... fminimum``), which no exception can catch."""
+    import subprocess
+    import sys
+
+    probe = subprocess.run([sys.executable, "-c", _LLVM_PROBE.format(variant=variant)],
+                           capture_output=True, text=True, timeout=300)
+    if probe.returncode != 0:
+        raise RenderError(
+            f"Mitsuba variant {variant!r} crashes here (libLLVM < 17?); install libllvm19 "
+            f"or use render.variant: scalar_spectral")
 
 
 @dataclass(frozen=True)

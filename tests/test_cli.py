@@ -69,3 +69,22 @@ def test_score_rescores_a_run_folder(tmp_path):
     assert all(0 <= r["rate"] <= 1 for r in fast["per_distance"])
     line = _one_line_error(_run("benchmark.cli", "score", tmp_path / "absent"))
     assert "not a run folder" in line
+
+
+def test_llvm_variant_never_aborts_the_process(tmp_path):
+    """With a libLLVM < 17 the LLVM variants abort the process on the first render; the
+    generator probes them in a child process and reports one line instead."""
+    import yaml
+
+    data = yaml.safe_load(SMOKE_MANIFEST.read_text())
+    data.update(environments=1, distances_m=[25])
+    data["render"]["variant"] = "llvm_ad_spectral"
+    manifest = tmp_path / "llvm.yaml"
+    manifest.write_text(yaml.safe_dump(data))
+    proc = _run("metricscenes.cli", "generate", "--manifest", manifest, "--out", tmp_path / "c")
+    if proc.returncode != 0:  # the image's libLLVM 15: a clear error, not an abort
+        line = _one_line_error(proc)
+        assert "llvm_ad_spectral" in line and "scalar_spectral" in line
+        assert proc.returncode == 2
+    else:  # a libLLVM >= 17 is installed: it renders
+        assert (tmp_path / "c" / "groundtruth.json").exists()
