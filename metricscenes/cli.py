@@ -60,6 +60,9 @@ def generate(
         if out is None:
             fail("--out is required unless --dry-run")
         from metricscenes.generate import generate as run_generate
+        from metricscenes.render import check_variant
+
+        check_variant(m.render.variant)  # before any output: an LLVM variant can abort the process
 
         started = time.perf_counter()
         with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),

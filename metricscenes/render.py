@@ -11,6 +11,7 @@ system's libllvm15 and are only used when asked for explicitly.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -31,10 +32,7 @@ def use_variant(variant: str = "scalar_spectral", threads: int | None = None):
     import mitsuba as mi
 
     if _active_variant != variant:
-        if variant not in mi.variants():
-            raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
-        if variant.startswith("llvm"):
-            _probe_llvm(variant)
+        check_variant(variant)
         mi.set_variant(variant)
         _active_variant = variant
     if threads is not None:
@@ -51,6 +49,17 @@ mi.render(scene, spp=1)
 """
 
 
+def check_variant(variant: str) -> None:
+    """Raise :class:`RenderError` unless ``variant`` can render in this process."""
+    import mitsuba as mi
+
+    if variant not in mi.variants():
+        raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
+    if variant.startswith("llvm"):
+        _probe_llvm(variant)
+
+
+@lru_cache(maxsize=None)
 def _probe_llvm(variant: str) -> None:
     """Render 2x2 pixels with an LLVM variant in a child process first: with a libLLVM
     older than 17 (Debian 12's default is 15) the first render aborts the whole process
