@@ -98,7 +98,7 @@ def sweep(
         cams = [load_camera(name) for name in names]
         col = Collection.open(collection)
         conds = [c.strip() for c in conditions.split(",") if c.strip()]
-        known = list(getattr(col, "condition_names", col.conditions))
+        known = col.condition_names
         for condition in conds:
             if condition not in known:
                 fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")

@@ -60,7 +60,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     from metricscenes.groundtruth import scale_groundtruth
 
     out_dir = Path(out_dir)
-    (out_dir / "images").mkdir(parents=True, exist_ok=True)
+    (out_dir / "images" if save_images else out_dir).mkdir(parents=True, exist_ok=True)
     scenes = collection.scenes()
     timings = Timings()
     detections: list[dict] = []

@@ -161,7 +161,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     conditions = list(conditions)
     if not cameras or not conditions:
         raise ValueError("sweep needs at least one camera and one condition")
-    known = list(getattr(collection, "condition_names", collection.conditions))  # with the illuminance sweep's
+    known = list(collection.condition_names)  # with the illuminance sweep's
     for condition in conditions:
         if condition not in known:
             raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")

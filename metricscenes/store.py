@@ -275,13 +275,16 @@ class Collection:
 
     def angular_sampling(self, scene_id: str) -> list[dict]:
         """Per layer (plate, inset): its extent in tangent coordinates and its sampling in mrad per pixel."""
-        scene = self.radiance(scene_id, {})
-        return [
-            {"layer": name, "extent_tan": layer.extent.as_tuple(),
-             "mrad_per_px": (1e3 * layer.pixel_tan[0], 1e3 * layer.pixel_tan[1]),
-             "shape": layer.radiance.shape}
-            for name, layer in zip(("plate", "inset"), scene.layers)
-        ]
+        env = self._image(scene_id)["environment_id"]
+        out = []
+        for name, path in (("plate", f"plates/env{env:03d}"), ("inset", f"insets/{scene_id}")):
+            node = self._group()[path]
+            arr = node[min(node.array_keys())]  # every light group of a unit shares its grid
+            extent = TanExtent(*arr.attrs["extent_tan"])
+            rows, cols = arr.shape[:2]
+            out.append({"layer": name, "extent_tan": extent.as_tuple(), "shape": arr.shape,
+                        "mrad_per_px": (1e3 * extent.width / cols, 1e3 * extent.height / rows)})
+        return out
 
     def verify(self) -> list[str]:
         """Recompute every array's sha256; return the paths whose content does not match."""

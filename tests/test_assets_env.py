@@ -10,6 +10,7 @@ import pytest
 
 mi.set_variant("scalar_spectral")
 
+from metricscenes.render import Film, spectral_film_dict
 from metricscenes.assets import roads, skies  # noqa: E402
 from metricscenes.assets.streetlights import FACE_SIZE_M, street_light_parts  # noqa: E402
 from metricscenes.spectral import WAVELENGTHS_NM  # noqa: E402
@@ -109,7 +110,7 @@ def test_street_light_illuminance_below_lamp():
     scene["integrator"] = {"type": "path", "max_depth": 2}
     scene["sensor"] = {"type": "perspective", "fov": 0.5,
                        "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0.2, 1], target=[0, 0, 0], up=[1, 0, 0]),
-                       "film": skies._specfilm(4, 4), "sampler": {"type": "stratified", "sample_count": 64}}
+                       "film": spectral_film_dict(Film(4, 4)), "sampler": {"type": "stratified", "sample_count": 64}}
     radiance = np.asarray(mi.render(mi.load_dict(scene))).reshape(-1, 31).mean(0)
     lux = skies.luminous_lm(np.pi * radiance / rho)
     d = height_m - 0.18

@@ -108,8 +108,11 @@ def test_conditions_are_linear_mixes_of_light_groups(smoke_collection):
     for a, b, ab in zip(day.layers, night.layers, both.layers):
         np.testing.assert_allclose(a.radiance + b.radiance, ab.radiance, rtol=1e-5, atol=1e-12)
     assert len(day.layers) == 2 and day.layers[1].extent.width < day.layers[0].extent.width
-    # The inset is finer than the plate.
+    # The inset is finer than the plate, and angular_sampling reports the layers' grids.
     assert day.layers[1].pixel_tan[0] < day.layers[0].pixel_tan[0]
+    for reported, layer in zip(c.angular_sampling(scene), day.layers, strict=True):
+        assert reported["extent_tan"] == layer.extent.as_tuple() and reported["shape"] == layer.radiance.shape
+        assert reported["mrad_per_px"] == pytest.approx((1e3 * layer.pixel_tan[0], 1e3 * layer.pixel_tan[1]))
     with pytest.raises(CollectionError, match="unknown condition"):
         c.radiance(scene, "dawn")
 

@@ -32,8 +32,9 @@ import colour
 import numpy as np
 
 from metricscenes.assets.parts import spectrum
+from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
 
-K_M_LM_W = 683.0
+K_M_LM_W = MAX_LUMINOUS_EFFICACY_LM_W
 """Maximum luminous efficacy of radiation for photopic vision, lm/W (CIE)."""
 
 LAMP_NM: np.ndarray = np.arange(380.0, 781.0, 5.0)

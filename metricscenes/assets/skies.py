@@ -33,14 +33,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from metricscenes.assets.lamps import photopic_v
 from metricscenes.assets.parts import spectrum
+from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
 from metricscenes.spectral import WAVELENGTHS_NM
 
 SKY_KINDS = ("day", "dusk", "night")
 SKIES_PER_KIND = 10
 N_SKIES = SKIES_PER_KIND * len(SKY_KINDS)
 SKY_LIGHT_GROUPS = {"day": "sky_day", "dusk": "sky_dusk", "night": "sky_night"}
-MAX_LUMINOUS_EFFICACY_LM_W = 683.0
 
 # Spectra are tabulated a little beyond 400-700 nm so every 10 nm band is fully covered.
 _GRID_NM = np.arange(380.0, 721.0, 5.0)
@@ -75,14 +76,6 @@ class SkySpec:
     @property
     def light_group(self) -> str:
         return SKY_LIGHT_GROUPS[self.kind]
-
-
-def photopic_v(wavelengths_nm: np.ndarray) -> np.ndarray:
-    """CIE 1924 photopic luminous efficiency V(λ) at ``wavelengths_nm`` (colour-science table)."""
-    import colour
-
-    sd = colour.colorimetry.SDS_LEFS_PHOTOPIC["CIE 1924 Photopic Standard Observer"]
-    return np.interp(wavelengths_nm, sd.wavelengths, sd.values, left=0.0, right=0.0)
 
 
 def luminous_lm(spectral_w_nm: np.ndarray, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> float:
@@ -215,14 +208,6 @@ def expected_illuminance_lux(spec: SkySpec) -> float:
     raise ValueError(f"expected_illuminance_lux is defined for dusk and night skies, got kind {spec.kind!r}")
 
 
-def _specfilm(width: int, height: int) -> dict:
-    """31 box bands of 10 nm (band-averaged radiance), zero-padded names, box filter."""
-    film = {"type": "specfilm", "width": width, "height": height, "rfilter": {"type": "box"}}
-    for c in WAVELENGTHS_NM:
-        film[f"b{int(c):04d}"] = spectrum([c - 5.0, c + 5.0], [0.1, 0.1], hold_ends=False)
-    return film
-
-
 def measure_illuminance_lux(emitters: dict[str, dict], albedo: float = 0.18, size_px: int = 8,
                             spp: int = 16, seed: int = 0) -> float:
     """Horizontal illuminance (lux) of ``emitters``, rendered on a grey Lambertian plane.
@@ -232,6 +217,8 @@ def measure_illuminance_lux(emitters: dict[str, dict], albedo: float = 0.18, siz
     """
     import mitsuba as mi
 
+    from metricscenes.render import Film, spectral_film_dict
+
     if "spectral" not in (mi.variant() or ""):
         raise ValueError(f"measure_illuminance_lux needs a spectral Mitsuba variant, got {mi.variant()!r}")
     T = mi.ScalarTransform4f
@@ -240,7 +227,7 @@ def measure_illuminance_lux(emitters: dict[str, dict], albedo: float = 0.18, siz
                         "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": albedo}}},
              "sensor": {"type": "perspective", "fov": 10.0,
                         "to_world": T().look_at(origin=[0, 0, 1], target=[0, 0, 0], up=[1, 0, 0]),
-                        "film": _specfilm(size_px, size_px),
+                        "film": spectral_film_dict(Film(size_px, size_px)),
                         "sampler": {"type": "stratified", "sample_count": spp, "seed": seed}},
              **emitters}
     image = np.asarray(mi.render(mi.load_dict(scene), spp=spp))
