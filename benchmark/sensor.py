@@ -177,6 +177,6 @@ def signal_volts_per_electron(sensor: SensorSpec) -> float:
 def saturation_electrons(sensor: SensorSpec) -> float:
     """Signal electrons at which the raw data saturates: the well, or the ADC white level
     less the black-level offset (the offset uses part of the swing, as in ISETCam),
-    whichever comes first. IMX363 defaults: min(6000, 959 DN / 0.1705 DN/e⁻) = 5626 e⁻."""
+    whichever comes first. IMX363 defaults (ISO 270): min(6000, 959 DN / 0.837 DN/e⁻) = 1146 e⁻."""
     adc_e = (sensor.white_level_dn - sensor.black_level_dn) * sensor.lsb_v / signal_volts_per_electron(sensor)
     return float(min(sensor.well_capacity_e, adc_e))

@@ -7,6 +7,7 @@ import pytest
 from benchmark import exposure, isp
 from benchmark.camera import simulate
 from benchmark.cameras import CameraSpec, load_camera
+from benchmark.sensor import signal_volts_per_electron
 from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import WAVELENGTHS_NM
@@ -34,7 +35,7 @@ def test_auto_exposure_puts_the_central_peak_at_90_percent(name):
     assert cap.exposure_s < 0.016  # not at the cap: the policy itself is tested
     rows, cols = exposure.central_region(cap.electrons.shape, cam.exposure.region_fraction)
     pct = cam.exposure.peak_percentile
-    peak_v = np.percentile(cap.electrons[rows, cols], pct) * cam.sensor.conversion_gain_uv_per_e * 1e-6
+    peak_v = np.percentile(cap.electrons[rows, cols], pct) * signal_volts_per_electron(cam.sensor)
     assert abs(peak_v / cam.sensor.voltage_swing_v - 0.90) < 0.02
     peak_dn = np.percentile(cap.raw_dn[rows, cols], pct)
     assert abs(peak_dn - (64 + 0.9 * 1023)) < 0.02 * 1023
@@ -57,7 +58,7 @@ def test_strict_peak_policy_and_glint_rejection():
     strict = simulate(glinted, strict_cam, seed=0, noise=False)
     rows, cols = exposure.central_region(strict.electrons.shape, 0.5)
     assert strict.exposure_s < plain.exposure_s / 10  # the glint alone sets the exposure
-    peak_v = strict.electrons[rows, cols].max() * 76.5e-6
+    peak_v = strict.electrons[rows, cols].max() * signal_volts_per_electron(cam.sensor)
     assert abs(peak_v / 0.4591 - 0.90) < 0.02
 
 
@@ -75,7 +76,7 @@ def test_fixed_and_mean_level_policies():
     mean_cam = _with(cam, exposure={"mode": "mean_level", "level": 0.25})
     cap = simulate(_textured_scene(1e-4), mean_cam, seed=0, noise=False)
     rows, cols = exposure.central_region(cap.electrons.shape, 0.5)
-    mean_v = cap.electrons[rows, cols].mean() * 76.5e-6
+    mean_v = cap.electrons[rows, cols].mean() * signal_volts_per_electron(cam.sensor)
     assert abs(mean_v / 0.4591 - 0.25) < 0.005
 
 

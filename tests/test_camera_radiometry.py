@@ -47,7 +47,7 @@ def test_uniform_field_electrons_match_hand_calculation(name):
     radiance = np.full(31, 0.01) * np.linspace(0.8, 1.2, 31)
     base = load_camera(name)
     per_s = _hand_electrons(radiance, base.f_number, base.pixel_um, 1.0, transmittance=0.9)
-    exposure_s = 3000.0 / per_s[1]  # about half the well in G: no clipping
+    exposure_s = 0.5 * sensor.saturation_electrons(base.sensor) / per_s[1]  # half the ceiling in G: no clipping
     cam = _fixed(name, exposure_s, transmittance=0.9)
     cap = simulate(SpectralScene.uniform(radiance), cam, seed=0, noise=False)
     expected = per_s * exposure_s
@@ -55,8 +55,8 @@ def test_uniform_field_electrons_match_hand_calculation(name):
     np.testing.assert_allclose(got, expected, rtol=0.01)
     # uniform in, uniform out: the OTF (DC gain 1) and the padding keep the borders exact
     assert np.ptp(cap.electrons[0::2, 0::2]) <= 1e-3 * expected[0]
-    # DN = black level + electrons × conversion gain / LSB
-    dn = 64 + expected * 76.5e-6 / (0.4591 / 1023)
+    # DN = black level + electrons × conversion gain × analog gain (ISO 270 / 55) / LSB
+    dn = 64 + expected * 76.5e-6 * (270 / 55) / (0.4591 / 1023)
     np.testing.assert_allclose(_site_means(cap.raw_dn.astype(float)), dn, atol=0.51)
 
 

@@ -8,7 +8,8 @@ from benchmark.cameras import load_camera
 from metricscenes.radiance import SpectralScene
 
 SPEC = load_camera("cam10").sensor
-K_SPEC = SPEC.conversion_gain_uv_per_e * 1e-6 / SPEC.lsb_v  # DN per electron, 0.1705
+K_SPEC = S.signal_volts_per_electron(SPEC) / SPEC.lsb_v  # DN per electron: 0.1705 × analog gain 4.91
+SATURATION_E = S.saturation_electrons(SPEC)
 
 
 def _pair(mean_e, seed, shape=(200, 200)):
@@ -19,7 +20,7 @@ def _pair(mean_e, seed, shape=(200, 200)):
 
 
 def test_photon_transfer_recovers_gain_read_noise_and_full_well():
-    levels_e = np.concatenate([np.linspace(0, 4500, 16), np.linspace(4700, 6500, 12)])  # 28 levels
+    levels_e = SATURATION_E * np.concatenate([np.linspace(0, 0.8, 16), np.linspace(0.84, 1.16, 12)])  # 28 levels
     mean_dn, var_dn = [], []
     for i, level in enumerate(levels_e):
         a, b = _pair(level, i)
@@ -43,12 +44,13 @@ def test_photon_transfer_recovers_gain_read_noise_and_full_well():
 
 
 def test_saturation_is_the_well_less_the_black_level_headroom():
-    assert abs(S.saturation_electrons(SPEC) - (1023 - 64) / K_SPEC) < 1e-6
+    assert abs(SATURATION_E - (1023 - 64) / K_SPEC) < 1e-6
+    assert abs(SATURATION_E - 1146.0) < 1.0  # ISO 270: the ADC, not the 6000 e⁻ well, sets the ceiling
     assert S.capture_dn(np.full((4, 4), 1e9, np.float32), 1.0, SPEC, np.random.default_rng(0)).max() == 1023
 
 
 def test_prnu_is_a_fixed_pattern_of_the_sensor():
-    rate = np.full((300, 300), 3000.0, dtype=np.float32)
+    rate = np.full((300, 300), 0.5 * SATURATION_E, dtype=np.float32)
     off = S.NoiseOptions(shot=False, read=False)
     a = S.capture_volts(rate, 1.0, SPEC, None, off)
     b = S.capture_volts(rate, 1.0, SPEC, None, off)
@@ -72,7 +74,7 @@ def test_seeded_noise():
 
 
 def test_every_noise_source_switches():
-    rate = np.full((100, 100), 2000.0, dtype=np.float32)
+    rate = np.full((100, 100), 0.4 * SATURATION_E, dtype=np.float32)
     base = S.capture_volts(rate, 1.0, SPEC, np.random.default_rng(1), S.NoiseOptions.off())
     assert np.ptp(base) == 0
     for field in ("shot", "read", "prnu"):

@@ -23,6 +23,11 @@ from metricscenes.geometry import (
 
 _STRICT = ConfigDict(extra="forbid", frozen=True)
 
+IMX363_ISO_SPEED = 270.0
+"""ISO speed of ISETCam's ``sensorIMX363`` (its default, used by the paper)."""
+IMX363_ISO_UNITY_GAIN = 55.0
+"""ISO at which the IMX363's analog gain is 1 (ISETCam: "for Pixel 4: ISO55")."""
+
 
 class OpticsSpec(BaseModel):
     """Diffraction-limited lens (circular pupil, no aberrations)."""
@@ -57,8 +62,9 @@ class SensorSpec(BaseModel):
     prnu_fraction: float = Field(0.007, ge=0.0, le=0.5)
     adc_bits: int = Field(10, ge=8, le=16)
     black_level_dn: int = Field(64, ge=0, le=4096)
-    analog_gain: float = Field(1.0, gt=0.0, le=64.0)
-    """Multiplies the pixel voltage (ISO 55 = 1, as ISETCam's isoUnityGain)."""
+    analog_gain: float = Field(IMX363_ISO_SPEED / IMX363_ISO_UNITY_GAIN, gt=0.0, le=64.0)
+    """Multiplies the pixel voltage: ISO speed / unity-gain ISO. ISETCam's sensorIMX363
+    runs at ISO 270 with unity gain at ISO 55, so 4.91 (usable well ≈ 1150 e⁻)."""
     fpn_seed: int = Field(0, ge=0)
     """Seed of the fixed-pattern noise maps (PRNU, DSNU): a property of the sensor
     unit, the same in every capture, independent of the capture seed."""
