@@ -32,6 +32,13 @@ def _spearman(x, y) -> float:
     return float(stats.spearmanr(x[ok], y[ok]).statistic)
 
 
+def ap_distance_rho(table: pd.DataFrame, condition: str = "day") -> pd.Series:
+    """Spearman's rho of AP against distance, per camera, under ``condition`` (NaN where
+    AP is constant or fewer than three distances have AP)."""
+    rows = table[table["condition"] == condition]
+    return rows.groupby("camera").apply(lambda part: _spearman(part["distance_m"], part["ap"]), include_groups=False)
+
+
 def paper_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", night: str = "night") -> dict[str, bool | float]:
     """Check the three findings on a sweep's tables (``sweep.csv``, ``od50.csv``).
 
@@ -52,7 +59,7 @@ def paper_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day",
             raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
 
     day_rows = table[table["condition"] == day]
-    rhos = [_spearman(part["distance_m"], part["ap"]) for _, part in day_rows.groupby("camera")]
+    rhos = ap_distance_rho(table, day).to_numpy()
     worst = float(np.max(rhos)) if not np.any(np.isnan(rhos)) else float("nan")
 
     paired = day_rows.merge(table[table["condition"] == night], on=["camera", "distance_m"], suffixes=("_day", "_night"))

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark.acceptance import paper_findings
+from benchmark.acceptance import ap_distance_rho, paper_findings
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 MTF50 = {"cam01": 60.0, "cam02": 80.0, "cam03": 110.0, "cam04": 150.0}
@@ -42,6 +42,8 @@ def test_ap_not_falling_with_distance_fails():
     res = paper_findings(*tables(day_ap=bumpy))
     assert not res["ap_falls_with_distance"]
     assert res["ap_distance_rho_worst"] == pytest.approx(-3 / 7)
+    rho = ap_distance_rho(tables(day_ap=bumpy)[0])
+    assert rho["cam02"] == pytest.approx(-3 / 7) and np.allclose(rho.drop("cam02"), -1.0)
     flat = paper_findings(*tables(day_ap=lambda cam, d: 0.9))  # constant AP: rho undefined, fails
     assert not flat["ap_falls_with_distance"] and np.isnan(flat["ap_distance_rho_worst"])
 
