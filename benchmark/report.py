@@ -216,8 +216,11 @@ def _main_figures(table: pd.DataFrame, od50: pd.DataFrame, fig_dir: Path) -> lis
                         "measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5; dashed: OD50 at "
                         "MTF50 100 cy/mm.", spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark)))
     if od50["camera"].nunique() >= 2 and od50["mtf50_cy_per_mm"].notna().all():
-        figures.append(("OD50 vs MTF50", "OD50 ± bootstrap SD over environments; least-squares line per "
-                        "condition, its slope in the legend.", spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50")))
+        measured = (float(table["distance_m"].min()), float(table["distance_m"].max()))
+        figures.append(("OD50 vs MTF50", "OD50 with its 95 % bootstrap interval over environments; least-squares "
+                        "line per condition through the OD50s inside the measured distances, its slope in the "
+                        "legend; hollow: extrapolated OD50s, not fitted (drawn at the top when beyond it).",
+                        spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50", measured_range_m=measured)))
     return figures
 
 

@@ -158,7 +158,8 @@ def fit_line(x, y) -> tuple[float, float]:
     return float(slope), float(intercept)
 
 
-def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title: str | None = None):
+def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title: str | None = None,
+                  measured_range_m: tuple[float, float] | None = None):
     """OD50 against MTF50, per condition, with a fitted line whose slope (m per cycle/mm)
     is in the legend (paper Fig. 7A). Error bars are the 95 % bootstrap interval when the
     table has it (``ci95_lo_m``, ``ci95_hi_m``): OD50 extrapolated beyond the measured
@@ -167,25 +168,39 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
 
     ``od50_table``: columns ``condition, mtf50_cy_per_mm, od50_m, sd_m`` (``od50.csv``).
     Infinite OD50s (AP never falls to 0.5) are left out of the plot and the fit.
+    ``measured_range_m`` (nearest, farthest distance, m): OD50s outside it are
+    extrapolations (the paper's outlier, Fig. 7A); they are drawn hollow, at the top of
+    the axes when they lie above it, and left out of the fit, so that one camera whose AP
+    never falls to 0.5 in the measured range cannot set the slope.
     """
     _require(od50_table, ("condition", "mtf50_cy_per_mm", "od50_m", "sd_m"))
     conditions = list(conditions) if conditions is not None else list(dict.fromkeys(od50_table["condition"]))
+    lo_m, hi_m = measured_range_m if measured_range_m is not None else (-np.inf, np.inf)
+    finite = od50_table[np.isfinite(od50_table["od50_m"].astype(float))]
+    inside = finite[finite["od50_m"].astype(float).between(lo_m, hi_m)]
+    top = max(_axis_top(inside if len(inside) else finite), 1.1 * hi_m if np.isfinite(hi_m) else 0.0)
     fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
     for k, condition in enumerate(conditions):
-        part = od50_table[od50_table["condition"] == condition]
-        part = part[np.isfinite(part["od50_m"].astype(float))]
+        part = finite[finite["condition"] == condition]
+        fitted = part["od50_m"].astype(float).between(lo_m, hi_m)
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
-        slope, intercept = fit_line(part["mtf50_cy_per_mm"], part["od50_m"])
-        label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}"
-        ax.errorbar(part["mtf50_cy_per_mm"], part["od50_m"], yerr=_error_bars(part, od50_table), fmt="o",
-                    color=colour, capsize=3, label=label)
+        slope, intercept = fit_line(part.loc[fitted, "mtf50_cy_per_mm"], part.loc[fitted, "od50_m"])
+        label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}: no fit"
+        if (~fitted).any():
+            label += f" ({int((~fitted).sum())} extrapolated: hollow, not fitted)"
+        ax.errorbar(part.loc[fitted, "mtf50_cy_per_mm"], part.loc[fitted, "od50_m"],
+                    yerr=_error_bars(part[fitted], top), fmt="o", color=colour, capsize=3, label=label)
+        outside = part[~fitted]
+        if len(outside):
+            ax.errorbar(outside["mtf50_cy_per_mm"], np.minimum(outside["od50_m"].astype(float), top),
+                        yerr=_error_bars(outside, top), fmt="o", mfc="none", color=colour, capsize=3, alpha=0.8)
         if np.isfinite(slope):
-            xs = np.linspace(part["mtf50_cy_per_mm"].min(), part["mtf50_cy_per_mm"].max(), 2)
+            xs = np.linspace(part.loc[fitted, "mtf50_cy_per_mm"].min(), part.loc[fitted, "mtf50_cy_per_mm"].max(), 2)
             ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
     interval = {"ci95_lo_m", "ci95_hi_m"} <= set(od50_table.columns)
-    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", ylim=(0, _axis_top(od50_table)),
+    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", ylim=(0, top),
            title=title or ("OD50 vs MTF50 (95 % bootstrap interval)" if interval else "OD50 vs MTF50 (± bootstrap SD)"))
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     if out is not None:
         save_figure(fig, out)
@@ -198,12 +213,12 @@ def _axis_top(table: pd.DataFrame) -> float:
     return 1.6 * float(finite.max()) if finite.size and finite.max() > 0 else 1.0
 
 
-def _error_bars(part: pd.DataFrame, table: pd.DataFrame) -> np.ndarray:
-    """(2, n) lower/upper bar lengths: the 95 % interval if present, else ± SD."""
-    od50 = part["od50_m"].astype(float).to_numpy()
+def _error_bars(part: pd.DataFrame, top: float) -> np.ndarray:
+    """(2, n) lower/upper bar lengths: the 95 % interval if present, else ± SD; OD50 and
+    interval clipped to the top of the axes."""
+    od50 = np.minimum(part["od50_m"].astype(float).to_numpy(), top)
     if {"ci95_lo_m", "ci95_hi_m"} <= set(part.columns):
-        top = _axis_top(table)
-        lo = np.clip(part["ci95_lo_m"].astype(float).to_numpy(), 0.0, None)
+        lo = np.minimum(np.clip(part["ci95_lo_m"].astype(float).to_numpy(), 0.0, None), od50)
         hi = np.minimum(part["ci95_hi_m"].astype(float).to_numpy(), top)
         return np.nan_to_num(np.stack([od50 - lo, np.maximum(hi - od50, 0.0)]))
     sd = part["sd_m"].astype(float).fillna(0.0).to_numpy()

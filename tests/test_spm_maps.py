@@ -102,6 +102,15 @@ def test_od50_vs_mtf50_slope_in_legend(tmp_path):
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert labels == ["day: slope 0.80 m per cy/mm", "night: slope 0.30 m per cy/mm"]
     assert (tmp_path / "od50.png").is_file() and (tmp_path / "od50.svg").is_file()
+    # an OD50 outside the measured distances is an extrapolation: drawn, not fitted
+    od.loc[3, "od50_m"] = 5000.0
+    od.loc[4, "od50_m"] = 0.0
+    plt.close(fig)
+    fig = spm.od50_vs_mtf50(od, tmp_path / "od50", measured_range_m=(25.0, 200.0))
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels == ["day: slope 0.80 m per cy/mm (1 extrapolated: hollow, not fitted)",
+                      "night: slope 0.30 m per cy/mm (1 extrapolated: hollow, not fitted)"]
+    assert fig.axes[0].get_ylim()[1] < 5000.0  # the extrapolation does not squash the axes
     assert spm.fit_line([1, 2, 3], [2, 4, 6]) == pytest.approx((2.0, 0.0))
     assert np.isnan(spm.fit_line([1, 1], [2, 3])[0])
     plt.close(fig)
