@@ -1,5 +1,7 @@
-"""The paper's qualitative findings, checked on the table the quick sweep produced
-(docs/data/sweep.csv and od50.csv, written by the commands in docs/results.md)."""
+"""The paper's qualitative findings, checked on the tables the quick sweeps produced
+(written by the commands in docs/results.md): the reference sweep (multiscale detector
+input, docs/data/sweep.csv and od50.csv) and the paper-parity sweep (YOLOv5's default
+640 input, docs/data/sweep-640.csv and od50-640.csv)."""
 
 from pathlib import Path
 
@@ -14,6 +16,11 @@ DATA = Path(__file__).resolve().parents[1] / "docs" / "data"
 @pytest.fixture(scope="module")
 def tables():
     return pd.read_csv(DATA / "sweep.csv"), pd.read_csv(DATA / "od50.csv")
+
+
+@pytest.fixture(scope="module")
+def paper_parity():
+    return pd.read_csv(DATA / "sweep-640.csv"), pd.read_csv(DATA / "od50-640.csv")
 
 
 def test_the_table_covers_13_cameras_day_and_night(tables):
@@ -40,7 +47,21 @@ def test_far_cars_score_lower_than_near_cars_for_every_camera(tables):
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "On quick (10 environments) the six finest cameras keep AP ≈ 0.87 out to 100 m, so the "
-    "per-camera Spearman rho of AP vs distance is only -0.54 to -0.77 for them (docs/results.md)"))
+    "With the reference multiscale input (native + 640) the five finest cameras keep AP ≈ 0.85–0.89 "
+    "out to 100–150 m (the native pass sees a 100 m car at 40–80 px), so their Spearman rho of AP vs "
+    "distance is only -0.49 to -0.77; the paper-parity sweep below meets the criterion (docs/results.md)"))
 def test_ap_falls_with_distance_for_every_camera(tables):
     assert paper_findings(*tables)["ap_falls_with_distance"]
+
+
+def test_paper_parity_sweep_covers_13_cameras_day_and_night(paper_parity):
+    table, od50 = paper_parity
+    assert table["camera"].nunique() == 13 and set(table["condition"]) == {"day", "night"}
+    assert len(table) == 13 * 2 * 6 and (table["n_images"] == 10).all() and len(od50) == 26
+
+
+def test_paper_parity_sweep_shows_all_three_findings(paper_parity):
+    findings = paper_findings(*paper_parity)
+    assert findings["ap_falls_with_distance"] and findings["ap_distance_rho_worst"] <= -0.8
+    assert findings["night_below_day"]
+    assert findings["od50_rises_with_mtf50"] and findings["od50_mtf50_rho"] >= 0.6
