@@ -176,26 +176,27 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     _require(od50_table, ("condition", "mtf50_cy_per_mm", "od50_m", "sd_m"))
     conditions = list(conditions) if conditions is not None else list(dict.fromkeys(od50_table["condition"]))
     lo_m, hi_m = measured_range_m if measured_range_m is not None else (-np.inf, np.inf)
-    finite = od50_table[np.isfinite(od50_table["od50_m"].astype(float))]
-    inside = finite[finite["od50_m"].astype(float).between(lo_m, hi_m)]
+    finite = od50_table.assign(od50_m=od50_table["od50_m"].astype(float))
+    finite = finite[np.isfinite(finite["od50_m"])]
+    finite = finite.assign(fitted=finite["od50_m"].between(lo_m, hi_m))
+    inside = finite[finite["fitted"]]
     top = max(_axis_top(inside if len(inside) else finite), 1.1 * hi_m if np.isfinite(hi_m) else 0.0)
     fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
     for k, condition in enumerate(conditions):
         part = finite[finite["condition"] == condition]
-        fitted = part["od50_m"].astype(float).between(lo_m, hi_m)
+        fitted, outside = part[part["fitted"]], part[~part["fitted"]]
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
-        slope, intercept = fit_line(part.loc[fitted, "mtf50_cy_per_mm"], part.loc[fitted, "od50_m"])
+        slope, intercept = fit_line(fitted["mtf50_cy_per_mm"], fitted["od50_m"])
         label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}: no fit"
-        if (~fitted).any():
-            label += f" ({int((~fitted).sum())} extrapolated: hollow, not fitted)"
-        ax.errorbar(part.loc[fitted, "mtf50_cy_per_mm"], part.loc[fitted, "od50_m"],
-                    yerr=_error_bars(part[fitted], top), fmt="o", color=colour, capsize=3, label=label)
-        outside = part[~fitted]
         if len(outside):
-            ax.errorbar(outside["mtf50_cy_per_mm"], np.minimum(outside["od50_m"].astype(float), top),
-                        yerr=_error_bars(outside, top), fmt="o", mfc="none", color=colour, capsize=3, alpha=0.8)
+            label += f" ({len(outside)} extrapolated: hollow, not fitted)"
+        # filled (and labelled) even when empty, so every condition has its legend entry
+        for points, style in ((fitted, {"label": label}), (outside, {"mfc": "none", "alpha": 0.8})):
+            if len(points) or "label" in style:
+                ax.errorbar(points["mtf50_cy_per_mm"], np.minimum(points["od50_m"], top),
+                            yerr=_error_bars(points, top), fmt="o", color=colour, capsize=3, **style)
         if np.isfinite(slope):
-            xs = np.linspace(part.loc[fitted, "mtf50_cy_per_mm"].min(), part.loc[fitted, "mtf50_cy_per_mm"].max(), 2)
+            xs = np.linspace(fitted["mtf50_cy_per_mm"].min(), fitted["mtf50_cy_per_mm"].max(), 2)
             ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
     interval = {"ci95_lo_m", "ci95_hi_m"} <= set(od50_table.columns)
     ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", ylim=(0, top),
