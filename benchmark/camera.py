@@ -4,6 +4,9 @@
 
     radiance (resampled to the pixel grid) ──optics──▶ electron-rate per channel
     ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
+
+The ``hdr`` exposure policy captures a long and a short raw and merges them before the
+ISP (:mod:`benchmark.hdr`), then tone-maps before the sRGB encoding.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from benchmark import exposure as _exposure
+from benchmark import hdr as _hdr
 from benchmark import isp as _isp
 from benchmark import optics as _optics
 from benchmark import sensor as _sensor
@@ -35,7 +39,13 @@ class Capture:
         camera_sha256: hash of the resolved camera spec.
         electrons: (height, width) float32 noise-free signal electrons of the mosaic.
         rgb_linear: (height, width, 3) float32 linear sRGB when ``isp.output`` is
-            ``linear``, else None.
+            ``linear``, else None (``hdr``: before the tone curve, 1 = the reference
+            exposure's white).
+        exposure_short_s: ``hdr`` only: the short exposure, s (``exposure_s`` and
+            ``raw_dn`` are then the long one's).
+        raw_short_dn: ``hdr`` only: the short exposure's raw, uint16.
+        merged_dn: ``hdr`` only: the merged raw (float32 DN on the long exposure's scale,
+            black level included) that the ISP processed.
     """
 
     rgb8: np.ndarray
@@ -48,6 +58,9 @@ class Capture:
     camera_sha256: str
     electrons: np.ndarray
     rgb_linear: np.ndarray | None = None
+    exposure_short_s: float | None = None
+    raw_short_dn: np.ndarray | None = None
+    merged_dn: np.ndarray | None = None
 
 
 def electron_rate(
@@ -83,6 +96,8 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
         noise: False switches every noise source off (shot, read, dark, PRNU, DSNU).
     """
     rate = _sensor.mosaic(electron_rate(scene, camera), camera.sensor.cfa)
+    if camera.exposure.mode == "hdr":
+        return _simulate_hdr(rate, camera, seed=seed, noise=noise)
     exposure_s = _exposure.exposure_time_s(rate, camera.sensor, camera.exposure)
     opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
     raw = _sensor.capture_dn(rate, exposure_s, camera.sensor, np.random.default_rng(seed), opts)
@@ -98,4 +113,37 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
         camera_sha256=camera.sha256(),
         electrons=np.multiply(rate, np.float32(exposure_s), dtype=np.float32),
         rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
+    )
+
+
+def _simulate_hdr(rate: np.ndarray, camera: CameraSpec, *, seed: int, noise: bool) -> Capture:
+    """The ``hdr`` policy on an electron-rate mosaic (e⁻/s): two raws, merge, ISP, tone curve.
+
+    The long frame draws its temporal noise from ``default_rng(seed)`` (the draws a
+    single capture would make), the short one from the first child of
+    ``SeedSequence(seed)`` (an independent stream): deterministic for a seed.
+    """
+    times = _exposure.hdr_exposures_s(rate, camera.sensor, camera.exposure)
+    opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
+    short_rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
+    raw_long = _sensor.capture_dn(rate, times.long_s, camera.sensor, np.random.default_rng(seed), opts)
+    raw_short = _sensor.capture_dn(rate, times.short_s, camera.sensor, short_rng, opts)
+    merged = _hdr.merge_two_exposures_dn(raw_long, raw_short, times.long_s / times.short_s, camera.sensor)
+    # Rescale so that 1 is the reference exposure's white, the tone curve's unit.
+    rgb_linear = _isp.process(merged, camera.sensor, camera.isp) * np.float32(times.reference_s / times.long_s)
+    toned = _isp.tone_curve_reinhard(rgb_linear, white=times.reference_s / times.short_s)
+    return Capture(
+        rgb8=_isp.encode_srgb8(toned),
+        raw_dn=raw_long,
+        exposure_s=times.long_s,
+        camera_name=camera.name,
+        width_px=camera.width_px,
+        height_px=camera.height_px,
+        seed=int(seed),
+        camera_sha256=camera.sha256(),
+        electrons=np.multiply(rate, np.float32(times.long_s), dtype=np.float32),
+        rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
+        exposure_short_s=times.short_s,
+        raw_short_dn=raw_short,
+        merged_dn=merged,
     )

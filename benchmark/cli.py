@@ -21,6 +21,8 @@ cli_detect.register(app)
 cli_leaderboard.register(app)
 console = Console()
 err = Console(stderr=True)
+EXPOSURE_HELP = ("exposure policy for every camera, replacing the camera's own: auto_peak (the paper's), mean_level, "
+                 "percentile:P, hdr[:RATIO], fixed:SECONDS, each but fixed with an optional @LEVEL (docs/camera.md)")
 
 
 def fail(message: str, code: int = 2) -> None:
@@ -42,15 +44,18 @@ def run(
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the camera's sRGB images")] = True,
     backend: Annotated[str, typer.Option(help="faster-coco-eval | pycocotools")] = "faster-coco-eval",
+    exposure: Annotated[Optional[str], typer.Option(help=EXPOSURE_HELP)] = None,
 ) -> None:
     """Simulate one camera on a collection, detect cars, print AP per distance."""
     from benchmark.cameras import load_camera
     from benchmark.detectors import DetectorError, load_detector
+    from benchmark.exposure import format_exposure, parse_exposure, with_exposure
     from benchmark.run import run_camera
     from metricscenes.store import Collection, CollectionError
 
     try:
-        cam = load_camera(camera)
+        policy = parse_exposure(exposure) if exposure is not None else None
+        cam = with_exposure(load_camera(camera), policy)
         col = Collection.open(collection)
         if condition not in col.condition_names:
             fail(f"unknown condition {condition!r} (this collection has: {', '.join(col.condition_names)})")
@@ -62,7 +67,10 @@ def run(
         task = bar.add_task(f"{cam.name} · {condition}", total=len(col.scenes()))
         results = run_camera(col, cam, condition, detector, out, seed=seed, save_images=save_images,
                              backend=backend, progress=lambda done, total: bar.update(task, completed=done))
-    table = Table(title=f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}")
+    title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
+    if policy is not None:
+        title += f" · exposure {format_exposure(policy)}"
+    table = Table(title=title)
     for col_name in ("distance (m)", "AP", "AP50", "images"):
         table.add_column(col_name, justify="right")
     for row in results["per_distance"]:
@@ -86,14 +94,17 @@ def sweep(
     mtf_source: Annotated[str, typer.Option(help="MTF50 of each camera: measured | analytic | published")] = "measured",
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the cameras' sRGB images (for the report's strips)")] = True,
+    exposure: Annotated[Optional[str], typer.Option(help=EXPOSURE_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
     from benchmark import sweep as sweep_module
     from benchmark.cameras import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
+    from benchmark.exposure import format_exposure, parse_exposure
     from metricscenes.store import Collection, CollectionError
 
     try:
+        policy = parse_exposure(exposure) if exposure is not None else None
         names = camera_names() if cameras.strip().lower() == "all" else [c.strip() for c in cameras.split(",") if c.strip()]
         cams = [load_camera(name) for name in names]
         col = Collection.open(collection)
@@ -118,11 +129,14 @@ def sweep(
 
         try:
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
-                               progress=progress, mtf_source=mtf_source, save_images=save_images)
+                               progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy)
         except (ValueError, DetectorError, CollectionError, OSError) as exc:
             fail(str(exc).splitlines()[0])
     _, od50_table = sweep_module.load_sweep(out)
-    table = Table(title=f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments")
+    title = f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments"
+    if policy is not None:
+        title += f" · exposure {format_exposure(policy)}"
+    table = Table(title=title)
     table.add_column("camera")
     table.add_column("MTF50 (cy/mm)", justify="right")
     for condition in conds:

@@ -89,15 +89,32 @@ def mtf_command(
     names: Optional[list[str]] = typer.Argument(None, help="Cameras (default: all 13)."),
     as_json: bool = typer.Option(False, "--json", help="Print JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the MTF curves to this image."),
+    isp_name: Optional[str] = typer.Option(
+        None, "--isp", help="ISP preset for every camera instead of its own: default (the project's) or "
+        "iset-parity (ISETCam's default image processor: bilinear, no white balance)."),
+    esfr: str = typer.Option(
+        "iso", "--esfr", help="e-SFR: iso (ISO 12233:2017, 5° edge) or isetcam (ISETCam's ISO12233v1 "
+        "and MTF50 rule on its 21° edge)."),
 ) -> None:
     """Measure MTF50 (ISO 12233 e-SFR through optics + sensor + demosaic)."""
+    from benchmark.cameras.spec import isp_preset
     from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
 
     cams = _load(names or [])
+    if esfr not in ("iso", "isetcam"):
+        _fail(f"unknown e-SFR {esfr!r} (allowed: iso, isetcam)")
+    if isp_name is not None:
+        try:
+            preset = isp_preset(isp_name)
+        except ValueError as exc:
+            _fail(str(exc))
+        cams = [cam.model_copy(update={"isp": preset}) for cam in cams]
+    # the plain command's output stays as it was; the options are named where they apply
+    tagged = isp_name is not None or esfr != "iso"
     results, curves = [], []
     for cam in cams:
         try:
-            m = measure_mtf50(cam)
+            m = measure_mtf50(cam, esfr=esfr)
         except ValueError as exc:
             _fail(f"{cam.name}: {exc}")
         curves.append((cam.name, m["freq_cy_per_mm"], m["mtf"]))
@@ -109,13 +126,17 @@ def mtf_command(
             "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(cam.pixel_um, cam.f_number), 2),
             "mtf50_group": cam.mtf50_group_cy_per_mm,
             "nyquist_cy_per_mm": round(500.0 / cam.pixel_um, 2),
+            **({"isp": isp_name or "camera", "esfr": esfr} if tagged else {}),
         })
     if plot is not None:
         _plot(curves, plot)
     if as_json:
         print(json.dumps(results, indent=2))
         return
-    table = Table(title="MTF50 (cycles/mm on the sensor); analytic = diffraction x pixel, polychromatic")
+    title = "MTF50 (cycles/mm on the sensor); analytic = diffraction x pixel, polychromatic"
+    if tagged:
+        title += f"; ISP {isp_name or 'of each camera'}, e-SFR {esfr}"
+    table = Table(title=title)
     for col in ("name", "pixel µm", "f-number", "measured", "analytic", "paper group", "Nyquist"):
         table.add_column(col, justify="right")
     for r in results:

@@ -145,6 +145,8 @@ def encode_srgb8(rgb_linear: np.ndarray) -> np.ndarray:
 def process(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec) -> np.ndarray:
     """Raw Bayer DN (rows, cols) → linear sRGB (rows, cols, 3) float32 (not clipped)."""
     rgb = white_balanced_rgb(raw_dn, sensor, isp)
+    if isp.color_transform == "iset_mcc":
+        return iset_render(rgb, sensor)
     m = color_matrix(sensor).astype(np.float32)
     return np.matmul(rgb, m.T)
 
@@ -154,6 +156,74 @@ def white_balanced_rgb(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec) -> 
     lin = raw_to_linear(raw_dn, sensor)
     if isp.white_balance == "grey_world":
         gains = grey_world_gains(lin, sensor.cfa)
+    elif isp.white_balance == "none":
+        gains = np.ones(3)
     else:
         gains = illuminant_gains(sensor, isp.illuminant)
     return demosaic(apply_gains(lin, gains, sensor.cfa), isp.demosaic, sensor.cfa)
+
+
+def tone_curve_reinhard(rgb_linear: np.ndarray, white: float) -> np.ndarray:
+    """Global tone curve of the ``hdr`` exposure policy, applied before :func:`encode_srgb8`.
+
+    Reinhard, Stark, Shirley & Ferwerda (2002), "Photographic tone reproduction for
+    digital images", SIGGRAPH, eq. 4 (the global operator with a white point), on each
+    linear channel: T(x) = x (1 + x / w²) / (1 + x), so T(0) = 0, T(w) = 1, and for w = 1
+    T is the identity. The input is scaled so that 1 is the white of the reference
+    (``auto_peak``) exposure — the auto exposure plays the role of Reinhard's key — and
+    w is the merged white in those units (t_ref / t_short ≥ 1): a merge that holds no
+    more than the reference's range is left as it is, a wider one is compressed into it.
+    """
+    x = np.maximum(np.asarray(rgb_linear, dtype=np.float32), np.float32(0.0))
+    w2 = np.float32(float(white) ** 2)
+    return x * (1.0 + x / w2) / (1.0 + x)
+
+
+# --- ISETCam's default image processor (isp_preset("iset-parity")) -------------------
+
+
+@functools.lru_cache(maxsize=32)
+def _iset_mcc_matrix_cached(qe: str) -> np.ndarray:
+    sensor = SensorSpec(pixel_um=1.0, qe=qe)  # the matrix depends on the spectral data only
+    _, refl = checker_reflectances()
+    resp = channel_responsivity(sensor)
+    d65 = illuminant_spectrum("D65")
+    cam = (refl * d65) @ resp.T / (d65 @ resp[1])  # not white-balanced: G of white = 1
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    xyz_bar = np.stack([np.interp(WAVELENGTHS_NM, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], 1)
+    xyz = (refl * d65) @ xyz_bar / (d65 @ xyz_bar[:, 1])
+    t, *_ = np.linalg.lstsq(cam, xyz, rcond=None)  # xyz ≈ cam @ t, unconstrained
+    return t.T
+
+
+def iset_mcc_matrix(sensor: SensorSpec) -> np.ndarray:
+    """3×3 matrix from camera RGB (not white-balanced) to CIE XYZ: ISETCam's 'MCC
+    optimized' sensor conversion (ISET/isetcam ``imgproc/imageSensorCorrection.m`` →
+    ``ieColorTransform(sensor,'XYZ','D65','mcc')`` → ``imageSensorTransform.m``:
+    ``T = sensorResponse \\ targetResponse``), the unconstrained least-squares fit of the
+    sensor's responses to the 24 ColorChecker patches under D65 to their XYZ. Our camera
+    RGB counts photo-electrons, so it pairs with ordinary XYZ as ISETCam's quanta
+    responses pair with ``xyzQuanta``. Rows need not sum to anything: ISETCam fixes the
+    scale at the end (:func:`iset_render`)."""
+    return _iset_mcc_matrix_cached(sensor.qe).copy()
+
+
+def iset_render(rgb_sensor: np.ndarray, sensor: SensorSpec) -> np.ndarray:
+    """ISETCam's default rendering of demosaicked sensor RGB (its 'sensor space') to
+    linear display RGB in [0, 1] (float32), as ``ipCompute`` with the default ``ip``:
+
+    1. XYZ = sensor RGB × :func:`iset_mcc_matrix`, clipped at 0
+       (``imgproc/imageSensorCorrection.m``);
+    2. illuminant correction 'None': nothing (``imgproc/imageIlluminantCorrection.m``);
+    3. XYZ to linear display RGB, clipped at 0, divided by the image's maximum
+       (``displays/displayRender.m``, the quantised-sensor branch: "img/max(img(:))").
+
+    ISETCam's default display is ``lcdExample.mat``; we use the sRGB primaries, which it
+    approximates. The image-dependent scale is ISETCam's: the brightest pixel becomes 1.
+    """
+    rgb = np.asarray(rgb_sensor, dtype=np.float32)
+    xyz = np.maximum(np.matmul(rgb, iset_mcc_matrix(sensor).astype(np.float32).T), np.float32(0.0))
+    to_rgb = np.asarray(colour.RGB_COLOURSPACES["sRGB"].matrix_XYZ_to_RGB, dtype=np.float32)
+    lin = np.maximum(np.matmul(xyz, to_rgb.T), np.float32(0.0))
+    peak = float(lin.max()) if lin.size else 0.0
+    return lin / np.float32(peak) if peak > 0 else lin

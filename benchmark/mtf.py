@@ -12,9 +12,19 @@ Frequencies are cycles/mm on the sensor along the edge normal.
 The camera measurement renders :func:`benchmark.targets.slanted_edge_scene` through the
 same optics, sensor (noise off, quantised) and demosaic as :func:`benchmark.camera.simulate`,
 and analyses the luminance 0.3 R + 0.6 G + 0.1 B (ISETCam).
+
+``measure_mtf50(camera, esfr="isetcam")`` measures as ISETCam did for the paper's MTF50
+groups (ISET/isetauto ``papers/EI2023/s_eiSensorFnumber.m``: ``ieISO12233(ip, sensor)``
+with the default ``ip``): :func:`esf_mtf_isetcam` ports ISETCam's ``ISO12233v1`` e-SFR
+and :func:`mtf50_isetcam` its MTF50 rule, on ISETCam's 21° slanted bar. With
+``isp_preset("iset-parity")`` (bilinear demosaic, no white balance) the luminance is
+taken, as ``ieISO12233`` does, from the demosaicked sensor RGB. docs/camera.md compares
+the two measurements camera by camera.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import scipy.optimize
@@ -136,13 +146,129 @@ def mtf50_analytic_cy_per_mm(
     return float(scipy.optimize.brentq(mtf, 1e-6, hi))
 
 
-def measure_mtf50(camera: CameraSpec, *, roi_px: tuple[int, int] = (96, 192), angle_deg: float = 5.0) -> dict:
+ISETCAM_EDGE_ANGLE_DEG = math.degrees(math.atan(1.0 / 2.6))
+"""Tilt from vertical of ISETCam's slanted bar, 21.04° (ISET/isetcam
+``scene/pattern/sceneSlantedBar.m``: the edge is y = 2.6 x)."""
+ISETCAM_ROI_PX = (96, 64)
+"""(rows, cols) of the ``esfr="isetcam"`` window: ISETCam's ``ISOFindSlantedBar`` takes
+a rect 1.5× taller than wide around the edge (the paper's were about 56 × 37 to
+78 × 52 pixels; over 37–64 columns the MTF50 moves by < 3 %)."""
+
+
+def _ahamming(n: int, mid: float) -> np.ndarray:
+    # Burns's asymmetric Hamming window, ISO12233v1's ahamming (1-based positions)
+    i = np.arange(1, n + 1)
+    return 0.54 + 0.46 * np.cos(np.pi * (i - mid) / max(mid - 1.0, n - mid))
+
+
+def _mround(x: float) -> int:
+    # MATLAB round: halves away from zero
+    return int(math.copysign(math.floor(abs(x) + 0.5), x))
+
+
+def esf_mtf_isetcam(image: np.ndarray, *, oversample: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """ISETCam's e-SFR (ISET/isetcam ``metrics/ISO/ISO12233v1.m``, Burns's 2002 sfrmat
+    as rewritten by ImagEval; ``ISO12233.m`` until ISETCam moved to sfrmat4), ported
+    line by line for a near-vertical edge:
+
+    * per-row derivative [½, −½], centroids under a Hamming window, a linear fit
+      x = a + b·y, refined once with windows centred on the fit;
+    * every pixel binned at ¼ pixel by its *horizontal* distance x − b·y from the edge
+      (no cos θ correction: on a tilted edge the frequency axis is stretched by
+      1/cos θ, 7 % at ISETCam's 21°);
+    * central difference [½, 0, −½], shift to the centroid, symmetric Hamming window
+      over the 4 × cols samples, |FFT| normalised at DC; no correction for the
+      difference or the bin width (ISO 12233:2017's derivative correction).
+
+    Returns:
+        (frequency in cycles/pixel, MTF) up to 1 cycle/pixel.
+    """
+    img = np.asarray(image, dtype=float)
+    if img.shape[1] > img.shape[0]:  # ISETCam's rotatev: the edge runs along the long side
+        img = img.T
+    rows, cols = img.shape
+    fil1, fil2 = np.array([0.5, -0.5]), np.array([0.5, 0.0, -0.5])
+    if img[:, :5].sum() > img[:, cols - 6 :].sum():  # the derivative must be positive
+        fil1, fil2 = -fil1, -fil2
+    d = fil1[0] * img[:, 1:] + fil1[1] * img[:, :-1]
+    lsf_rows = np.concatenate([d[:, :1], d], axis=1)
+    pos = np.arange(1, cols + 1)
+
+    def centroids(window: np.ndarray) -> np.ndarray:
+        w = lsf_rows * window
+        return (w * pos).sum(1) / w.sum(1) - 0.5
+
+    y = np.arange(rows)
+    fit = np.polyfit(y, centroids(_ahamming(cols, (cols + 1) / 2)), 1)
+    place = fit[1] + fit[0] * np.arange(1, rows + 1)  # 1-based rows, as in ISO12233v1
+    fit = np.polyfit(y, centroids(np.stack([_ahamming(cols, p) for p in place])), 1)
+
+    n = cols * oversample
+    offset = _mround(-oversample * (rows - 1) * fit[0])
+    span = abs(offset)
+    offset = min(offset, 0)
+    bins = (np.ceil((np.arange(cols)[None, :] - y[:, None] * fit[0]) * oversample) - offset).astype(int)
+    length = n + span + 100
+    counts = np.bincount(bins.ravel(), minlength=length)
+    sums = np.bincount(bins.ravel(), weights=img.ravel(), minlength=length)
+    start = _mround(0.5 * span)
+    c, s = counts[start : start + n].astype(float), sums[start : start + n]
+    esf = np.divide(s, c, out=np.zeros(n), where=c > 0)  # an empty bin reads 0, as there
+
+    lsf = np.zeros(n)
+    lsf[2:] = fil2[0] * esf[2:] + fil2[2] * esf[:-2]
+    lsf[1] = lsf[2]
+    centre = (np.arange(1, n + 1) * lsf).sum() / lsf.sum()
+    shift = _mround(_mround(centre) - _mround((n + 1) / 2))
+    centred = np.zeros(n)
+    if shift > 0:
+        centred[: n - shift] = lsf[shift:]
+    else:
+        centred[-shift:] = lsf[: n + shift]
+    spectrum = np.abs(np.fft.fft(centred * _ahamming(n, (n + 1) / 2)))
+    keep = _mround((n // 2 + 1) / 2)
+    freq = oversample * np.arange(keep) / n
+    return freq, spectrum[:keep] / spectrum[0]
+
+
+def mtf50_isetcam(freq_cy_per_mm: np.ndarray, mtf: np.ndarray, nyquist_cy_per_mm: float,
+                  step_cy_per_mm: float = 0.2) -> float:
+    """ISETCam's MTF50 (``ISO12233v1.m``): the MTF below Nyquist, linearly interpolated
+    every 0.2 cycles/mm, and the grid frequency whose MTF is *closest* to 0.5 (not the
+    first crossing: an MTF that stays above 0.5 gives about the Nyquist frequency)."""
+    below = freq_cy_per_mm < nyquist_cy_per_mm
+    grid = np.arange(0.0, nyquist_cy_per_mm + 1e-9, step_cy_per_mm)
+    f, m = freq_cy_per_mm[below], mtf[below]
+    values = np.interp(grid, f, m, left=np.nan, right=np.nan)
+    return float(grid[np.nanargmin(np.abs(values - 0.5))])
+
+
+def measure_mtf50(
+    camera: CameraSpec,
+    *,
+    roi_px: tuple[int, int] | None = None,
+    angle_deg: float | None = None,
+    esfr: str = "iso",
+) -> dict:
     """Measured MTF50 of ``camera``: a D65 grey slanted edge through its optics, sensor
     (noise off, quantised) and demosaic, luminance e-SFR.
+
+    White balance: D65 gains on the mosaic, or none where ``camera.isp.white_balance``
+    is ``none`` (ISETCam's ``ieISO12233`` reads the demosaicked, unbalanced 'sensor
+    space'). The colour matrix and the sRGB curve are never applied: the luminance is
+    taken from linear camera RGB. ``esfr``: ``iso`` (:func:`esf_mtf`, a 5° edge in a
+    96 × 192 window) or ``isetcam`` (:func:`esf_mtf_isetcam` and :func:`mtf50_isetcam`
+    on ISETCam's 21° edge in a 96 × 64 window); ``roi_px``/``angle_deg`` override.
 
     Returns:
         dict with ``mtf50_cy_per_mm``, ``mtf50_cy_per_px``, ``freq_cy_per_mm`` and ``mtf``.
     """
+    if esfr not in ("iso", "isetcam"):
+        raise ValueError(f"unknown e-SFR {esfr!r} (allowed: iso, isetcam)")
+    iset = esfr == "isetcam"
+    roi_px = roi_px or (ISETCAM_ROI_PX if iset else (96, 192))
+    if angle_deg is None:
+        angle_deg = ISETCAM_EDGE_ANGLE_DEG if iset else 5.0
     d65 = isp.illuminant_spectrum("D65")
     scene, extent = slanted_edge_scene(
         camera.width_px, camera.height_px, d65 * 1e-3, roi_px=roi_px, angle_deg=angle_deg
@@ -152,12 +278,19 @@ def measure_mtf50(camera: CameraSpec, *, roi_px: tuple[int, int] = (96, 192), an
     exposure_s = exposure.exposure_time_s(rate, camera.sensor, policy)
     raw = sensor.capture_dn(rate, exposure_s, camera.sensor, None, sensor.NoiseOptions.off())
     lin = isp.raw_to_linear(raw, camera.sensor)
-    balanced = isp.apply_gains(lin, isp.illuminant_gains(camera.sensor, "D65"), camera.sensor.cfa)
+    if camera.isp.white_balance == "none":
+        balanced = lin
+    else:
+        balanced = isp.apply_gains(lin, isp.illuminant_gains(camera.sensor, "D65"), camera.sensor.cfa)
     rgb = isp.demosaic(balanced, camera.isp.demosaic, camera.sensor.cfa)
     lum = rgb @ LUMINANCE_WEIGHTS
-    freq, mtf = esf_mtf(lum[4:-4, 4:-4])  # drop the demosaic's border
-    per_px = mtf50(freq, mtf)
     pixel_mm = camera.pixel_um * 1e-3
+    if iset:
+        freq, mtf = esf_mtf_isetcam(lum[4:-4, 4:-4])  # drop the demosaic's border
+        per_px = mtf50_isetcam(freq / pixel_mm, mtf, 0.5 / pixel_mm) * pixel_mm
+    else:
+        freq, mtf = esf_mtf(lum[4:-4, 4:-4])  # drop the demosaic's border
+        per_px = mtf50(freq, mtf)
     return {
         "mtf50_cy_per_mm": per_px / pixel_mm,
         "mtf50_cy_per_px": per_px,

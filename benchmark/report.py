@@ -50,7 +50,10 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
     if (root / "sweep.csv").is_file():
         table, od50 = load_sweep(root)
         meta = json.loads((root / "sweep.json").read_text()) if (root / "sweep.json").is_file() else {}
-        runs = {(c, k): root / "runs" / run_name(c, k) for c, k in od50[["camera", "condition"]].itertuples(index=False)}
+        # sweep.json names each run's folder (tagged when an exposure policy overrode the cameras')
+        paths = {(r["camera"], r["condition"]): root / r["path"] for r in meta.get("runs", []) if "path" in r}
+        runs = {(c, k): paths.get((c, k), root / "runs" / run_name(c, k))
+                for c, k in od50[["camera", "condition"]].itertuples(index=False)}
         return table, od50, runs, meta
     if not (root / "results.json").is_file():
         raise ValueError(f"{root} is neither a sweep folder (sweep.csv) nor a run folder (results.json)")

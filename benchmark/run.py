@@ -65,6 +65,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     timings = Timings()
     detections: list[dict] = []
     exposures: dict[str, float] = {}
+    short_exposures: dict[str, float] = {}  # the hdr policy's second frame
     for i, scene in enumerate(scenes):
         t = time.perf_counter()
         radiance = collection.radiance(scene.scene_id, condition)
@@ -73,6 +74,8 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
         capture = simulate(radiance, camera, seed=scene_seed(seed, scene.image_id))
         timings.add("camera", t)
         exposures[scene.scene_id] = capture.exposure_s
+        if capture.exposure_short_s is not None:
+            short_exposures[scene.scene_id] = capture.exposure_short_s
         t = time.perf_counter()
         # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
         (found,) = detector.detect([capture.rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
@@ -119,6 +122,8 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
         "detections_sha256": sha256_bytes(detections_bytes),
         "timing_s": {k: round(v, 3) for k, v in timings.seconds.items()},
     }
+    if short_exposures:  # hdr only (other results keep their bytes); exposure_s holds the long frames
+        results["exposure_short_s"] = short_exposures
     (out_dir / "detections.json").write_bytes(detections_bytes)
     (out_dir / "groundtruth.json").write_text(json.dumps(groundtruth))
     (out_dir / "results.json").write_text(json.dumps(results, indent=1))

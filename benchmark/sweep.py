@@ -1,7 +1,9 @@
 """Every camera × condition on one collection: a tidy AP table and OD50 ± SD per run.
 
 Each (camera, condition) pair is one :func:`benchmark.run.run_camera` call in
-``out_dir/runs/<camera>-<condition>/``. Runs are cached: a run folder whose
+``out_dir/runs/<camera>-<condition>/`` (``<camera>-<condition>+<policy>/`` where a
+``--exposure`` policy changed the camera's own, e.g. ``cam01-day+hdr-16``, so that sweeps
+of several policies share one folder without overwriting). Runs are cached: a run folder whose
 ``results.json`` carries the same key — camera spec sha256, condition, detector sha256
 and input size, collection manifest sha256, seed — is reused, not recomputed.
 ``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
@@ -28,10 +30,13 @@ import os
 import re
 import warnings
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import TYPE_CHECKING, Callable, Iterable
 
 import numpy as np
 import pandas as pd
+
+if TYPE_CHECKING:
+    from benchmark.cameras.spec import ExposureSpec
 
 SWEEP_FORMAT = "metricscenes-sweep/1"
 MTF_SOURCES = ("measured", "analytic", "published")
@@ -45,9 +50,10 @@ _ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")
 Progress = Callable[[int, int, str], None]
 
 
-def run_name(camera_name: str, condition: str) -> str:
-    """Folder name of one run under ``out_dir/runs``."""
-    return f"{camera_name}-{condition}"
+def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) -> str:
+    """Folder name of one run under ``out_dir/runs`` (``exposure_tag``: the overriding
+    exposure policy's :func:`benchmark.exposure.exposure_tag`)."""
+    return f"{camera_name}-{condition}" + (f"+{exposure_tag}" if exposure_tag else "")
 
 
 def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
@@ -131,7 +137,8 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
 
 def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
           n_resamples: int = 1000, progress: Progress | None = None, mtf_source: str = "measured",
-          backend: str = "faster-coco-eval", save_images: bool = True) -> pd.DataFrame:
+          backend: str = "faster-coco-eval", save_images: bool = True,
+          exposure: ExposureSpec | None = None) -> pd.DataFrame:
     """Run every camera × condition (reusing cached runs); write and return the AP table.
 
     Args:
@@ -145,19 +152,27 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
             run advances by all its scenes at once.
         mtf_source: ``measured`` | ``analytic`` | ``published`` (see :func:`camera_mtf50`).
+        exposure: an :class:`ExposureSpec` replacing every camera's exposure block (None:
+            each camera's own); it changes the spec sha256 (the cache key) and tags the
+            folders of the runs it changed (:func:`run_name`).
 
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
     """
     from benchmark import run as run_module
     from benchmark.cameras import load_camera
+    from benchmark.exposure import exposure_tag, format_exposure, with_exposure
     from metricscenes.store import Collection
 
     if mtf_source not in MTF_SOURCES:
         raise ValueError(f"mtf_source must be one of {MTF_SOURCES}, got {mtf_source!r}")
     if isinstance(collection, (str, os.PathLike)):
         collection = Collection.open(collection)
-    cameras = [c if hasattr(c, "sha256") else load_camera(c) for c in cameras]
+    own = [c if hasattr(c, "sha256") else load_camera(c) for c in cameras]
+    cameras = [with_exposure(c, exposure) for c in own]
+    # A run folder is tagged only where the policy changed the camera: cam01-day always
+    # holds the camera's own spec, and `--exposure auto_peak` reuses the reference runs.
+    tags = {c.name: exposure_tag(exposure) if c.exposure != o.exposure else None for c, o in zip(cameras, own)}
     conditions = list(conditions)
     if not cameras or not conditions:
         raise ValueError("sweep needs at least one camera and one condition")
@@ -180,7 +195,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                  "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
         for condition in conditions:
             label = f"{camera.name} · {condition}"
-            run_dir = out_dir / "runs" / run_name(camera.name, condition)
+            run_dir = out_dir / "runs" / run_name(camera.name, condition, tags[camera.name])
             results = cached_results(run_dir, run_key(camera, condition, detector, collection, seed))
             reused = results is not None
             if results is None:
@@ -216,6 +231,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         "table": _json_safe(table.to_dict(orient="records")),
         "od50": _json_safe(od50_table.to_dict(orient="records")),
     }
+    if exposure is not None:  # only then, so that other sweeps keep their bytes
+        meta["exposure"] = {"policy": format_exposure(exposure), "tag": exposure_tag(exposure),
+                            "spec": exposure.model_dump(mode="json")}
     _write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
     return table
 

@@ -222,12 +222,27 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
         for u in todo:
             finish(render_unit(manifest_json, u, str(root), threads))
     else:
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             futures = [pool.submit(render_unit, manifest_json, u, str(root), threads) for u in todo]
             for f in futures:
                 finish(f.result())
     _finalize(root, manifest, scenes, records)
     return root
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """Worker initializer: on Linux, ask the kernel to SIGTERM this worker when its parent
+    dies (a killed ``generate`` otherwise leaves its workers rendering, ~300 MB each),
+    and leave at once if the parent died before this worker got here."""
+    import ctypes
+    import signal
+    import sys
+
+    if sys.platform.startswith("linux"):
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    if os.getppid() != parent_pid:
+        os._exit(1)
 
 
 def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, dict]) -> None:

@@ -15,8 +15,8 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "car_lights", "street_lights")
-PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights")
+LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "car_lights", "street_lights", "ego_lights", "ego_high_beam")
+PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights", "ego_lights", "ego_high_beam")
 """Groups that can light the background; car lamps only matter where the car is (the inset)."""
 
 
@@ -55,11 +55,13 @@ class RenderSettings(_Strict):
 class IlluminanceSweep(_Strict):
     """Conditions ``<base>@<level>lux``: the base condition with its ambient group scaled
     so that the horizontal illuminance at the camera is ``level`` lux (the paper's
-    luminance sweep)."""
+    luminance sweep), plus ``lamps_on`` at weight 1 (the vehicles' and the road's own
+    lamps, on at every level as they would be in low light)."""
 
     base: str
     ambient_group: Literal[PLATE_LIGHT_GROUPS]  # type: ignore[valid-type]
     levels_lux: tuple[float, ...] = Field(min_length=1)
+    lamps_on: tuple[Literal[LIGHT_GROUPS], ...] = ()  # type: ignore[valid-type]
 
     @field_validator("levels_lux")
     @classmethod
@@ -111,6 +113,9 @@ class Manifest(_Strict):
             if self.conditions[sweep.base].get(sweep.ambient_group, 0.0) <= 0.0:
                 raise ValueError(f"illuminance_sweep.ambient_group: {sweep.ambient_group!r} does not light "
                                  f"condition {sweep.base!r}")
+            for group in sweep.lamps_on:
+                if group not in self.light_groups or group == sweep.ambient_group:
+                    raise ValueError(f"illuminance_sweep.lamps_on: {group!r} is not a rendered lamp group")
         return self
 
     def sha256(self) -> str:

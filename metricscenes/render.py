@@ -153,8 +153,9 @@ def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
 ILLUMINANCE_METER_SPP = 1024
 
 
-def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed: int = 0) -> np.ndarray:
-    """Horizontal spectral irradiance (31,) W·m⁻²·nm⁻¹ at (0, 0, height_m) in a scene dict.
+def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed: int = 0,
+                      at_xy_m: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Horizontal spectral irradiance (31,) W·m⁻²·nm⁻¹ at (x, y, height_m) in a scene dict.
 
     A 2 cm white Lambertian patch (reflectance 1) is placed there and a radiance meter
     looks down at it: E = π L. Unlike Mitsuba's ``irradiancemeter``, this catches
@@ -166,11 +167,11 @@ def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed:
     scene = {k: v for k, v in scene_dict.items() if k != "sensor"}
     scene["illuminance_patch"] = {
         "type": "rectangle",
-        "to_world": mi.ScalarTransform4f().translate([0.0, 0.0, height_m]).scale(0.01),
+        "to_world": mi.ScalarTransform4f().translate([*map(float, at_xy_m), height_m]).scale(0.01),
         "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": 1.0}},
     }
     scene["sensor"] = {
-        "type": "radiancemeter", "origin": [0.0, 0.0, height_m + 0.1], "direction": [0.0, 0.0, -1.0],
+        "type": "radiancemeter", "origin": [*map(float, at_xy_m), height_m + 0.1], "direction": [0.0, 0.0, -1.0],
         "film": spectral_film_dict(Film(1, 1)),
         "sampler": {"type": "stratified", "sample_count": ILLUMINANCE_METER_SPP, "seed": int(seed) % 2**31},
     }

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from metricscenes.assets import cars, roads, skies
+from metricscenes.assets import cars, ego_vehicle, roads, skies
 from metricscenes.assets.parts import SceneParts
 from metricscenes.plan import EnvironmentPlan
 from metricscenes.render import Film, sensor_dict
@@ -48,7 +48,8 @@ def car_pose(env: EnvironmentPlan, distance_m: float) -> CarPose:
 
 
 def environment_parts(env: EnvironmentPlan) -> SceneParts:
-    return roads.road_parts(roads.road_spec(env.road_id), seed=env.seed)
+    """The road, its trees and street lights, and the camera vehicle's own head lamps."""
+    return roads.road_parts(roads.road_spec(env.road_id), seed=env.seed).merged(ego_vehicle.ego_lamp_parts())
 
 
 def car_parts(env: EnvironmentPlan, pose: CarPose) -> SceneParts:

@@ -200,6 +200,8 @@ class Collection:
         if measured <= 0.0:
             raise CollectionError(f"{self.root}: no {group} illuminance recorded for env{environment_id:03d}")
         weights[group] = level / measured
+        for lamp_group in sweep.get("lamps_on", ()):
+            weights[lamp_group] = 1.0
         return weights
 
     def illuminance_lux(self, scene_id: str, condition: str | dict[str, float]) -> float:

@@ -12,12 +12,13 @@ SMOKE_MANIFEST = REPO / "manifests" / "smoke.yaml"
 
 
 def model_dir() -> Path:
-    return Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
+    # Resolved once against the working directory, as the README's relative path needs.
+    return Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models")).expanduser().resolve()
 
 
 # Registry names resolve in METRICSCENES_MODEL_DIR: default it to the shared folder beside
 # the checkout, so tests that use a registry name skip or pass the same way as the rest.
-os.environ.setdefault("METRICSCENES_MODEL_DIR", str(model_dir()))
+os.environ["METRICSCENES_MODEL_DIR"] = str(model_dir())
 
 
 def require_model(name: str) -> Path:

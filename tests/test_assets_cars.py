@@ -9,6 +9,7 @@ import colour
 import numpy as np
 import pytest
 
+from metricscenes.assets import beams  # noqa: E402
 from metricscenes.assets import cars, lamps, materials
 from metricscenes.assets.parts import Lamp, SceneParts, spectrum
 from metricscenes.spectral import WAVELENGTHS_NM
@@ -140,13 +141,18 @@ def test_car_lamp_intensities_in_documented_ranges():
     geo = {lr.key: lr for lr in cars.car_geometry(spec).lamps}
     for mode, tail_key in (("auto", "tail"), ("brake", "brake")):
         for lamp in cars.car_parts(spec, (25.0, 0.0), 0.0, lights=mode).lamps:
-            kind = lamp.emitter["type"]
-            spec_dict = lamp.emitter["radiance" if kind == "area" else "intensity"]
+            spec_dict = lamp.emitter["radiance" if lamp.emitter["type"] == "area" else "intensity"]
             wl = np.array(spec_dict["wavelengths"].split(","), float)
             val = np.array(spec_dict["values"].split(","), float)
-            cd = lamps.luminous(wl, val) * (geo[lamp.name].area_m2 if kind == "area" else 1.0)
-            key = "low_beam" if kind == "spot" else ("headlamp_glare" if "head" in lamp.name else tail_key)
-            lo, typ, hi = lamps.INTENSITY_RANGES_CD[key]
+            if lamp.emitter["type"] == "spot":  # the low beam's peak, minus the lens
+                beam = beams.beam_texture("low", beams.HEADLAMP_LENS_CD)
+                assert lamps.luminous(wl, val) == pytest.approx(beam.peak_cd, rel=1e-3)
+                continue
+            cd = lamps.luminous(wl, val) * geo[lamp.name].area_m2
+            if "head" in lamp.name:
+                assert cd == pytest.approx(beams.HEADLAMP_LENS_CD, rel=1e-3)
+                continue
+            lo, typ, hi = lamps.INTENSITY_RANGES_CD[tail_key]
             assert lo <= cd <= hi, (lamp.name, cd)
             assert cd == pytest.approx(typ, rel=1e-3)
 

@@ -12,6 +12,7 @@ mi.set_variant("scalar_spectral")
 
 from metricscenes.render import Film, spectral_film_dict
 from metricscenes.assets import roads, skies  # noqa: E402
+from metricscenes.assets import beams  # noqa: E402
 from metricscenes.assets.streetlights import FACE_SIZE_M, street_light_parts  # noqa: E402
 from metricscenes.spectral import WAVELENGTHS_NM  # noqa: E402
 
@@ -19,6 +20,10 @@ from metricscenes.spectral import WAVELENGTHS_NM  # noqa: E402
 def _scene(parts, emitters=None, lamps_on=False) -> dict:
     d = {"type": "scene", **parts.shapes}
     for lamp in parts.lamps:
+        if lamp.shape is None:  # a goniometric spot: light only
+            if lamps_on:
+                d[lamp.name] = lamp.emitter
+            continue
         d[lamp.name] = {**lamp.shape, "emitter": lamp.emitter} if lamps_on else dict(lamp.shape)
     d.update(emitters or {})
     return d
@@ -67,7 +72,7 @@ def test_road_parts_load_fast_and_stay_off_the_corridor(road_id):
     assert all(lamp.light_group == "street_lights" for lamp in parts.lamps)
     assert bool(parts.lamps) == spec.street_lights
     if spec.street_lights:
-        assert len(scene.emitters()) == len(parts.lamps) >= 9
+        assert len(scene.emitters()) == len(parts.lamps) >= 18  # a cover and a spot per luminaire
     yc = roads.centre_line_y_m(spec)
     for key, shape in parts.shapes.items():
         if key.startswith(("tree_", "streetlight_")):
@@ -99,22 +104,25 @@ def test_ground_reaches_the_horizon():
         assert scene.ray_test(mi.Ray3f(mi.Point3f(0, 0, 1.5), d)), np.degrees(az)
 
 
-def test_street_light_illuminance_below_lamp():
-    """E = I / d² under a Lambertian luminaire face; L = ρ E / π on a grey plane."""
-    intensity_cd, height_m, rho = 5000.0, 9.0, 0.5
-    parts = street_light_parts([0.0], pole_y_m=3.0, arm_y_m=0.0, height_m=height_m, intensity_cd=intensity_cd)
+def test_street_light_illuminance_follows_its_candela_table():
+    """E = I cos(i) / d² from the luminaire's table (cover + spot), read as L = ρ E / π."""
+    flux_lm, height_m, rho = 10_000.0, 9.0, 0.5
+    parts = street_light_parts([0.0], pole_y_m=3.0, arm_y_m=0.0, height_m=height_m, flux_lm=flux_lm)
     scene = _scene(parts, lamps_on=True)
-    del scene["streetlight_poles"]  # keep only the face, so no shadowing of the measurement
-    scene["plane"] = {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([50, 50, 1]),
+    del scene["streetlight_poles"]  # keep only the luminaire, so no shadowing of the measurement
+    scene["plane"] = {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([80, 80, 1]),
                       "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": rho}}}
     scene["integrator"] = {"type": "path", "max_depth": 2}
-    scene["sensor"] = {"type": "perspective", "fov": 0.5,
-                       "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0.2, 1], target=[0, 0, 0], up=[1, 0, 0]),
-                       "film": spectral_film_dict(Film(4, 4)), "sampler": {"type": "stratified", "sample_count": 64}}
-    radiance = np.asarray(mi.render(mi.load_dict(scene))).reshape(-1, 31).mean(0)
-    lux = skies.luminous_lm(np.pi * radiance / rho)
-    d = height_m - 0.18
-    assert lux == pytest.approx(intensity_cd / d**2, rel=0.08)
+    lamp_z = height_m - 0.19
+    for x, y in ((0.0, 0.0), (12.0, -1.0), (25.0, -3.0)):  # street side is -y here
+        scene["sensor"] = {"type": "perspective", "fov": 0.5, "to_world": mi.ScalarTransform4f().look_at(
+                               origin=[x, y + 0.2, 1], target=[x, y, 0], up=[1, 0, 0]),
+                           "film": spectral_film_dict(Film(4, 4)), "sampler": {"type": "stratified", "sample_count": 64}}
+        radiance = np.asarray(mi.render(mi.load_dict(scene))).reshape(-1, 31).mean(0)
+        lux = skies.luminous_lm(np.pi * radiance / rho)
+        d = np.sqrt(x**2 + y**2 + lamp_z**2)
+        table_cd = beams.road_luminaire_cd(flux_lm, x / lamp_z, -y / lamp_z)
+        assert lux == pytest.approx(table_cd * lamp_z / d**3, rel=0.05), (x, y)
     assert FACE_SIZE_M[0] * FACE_SIZE_M[1] > 0
 
 

@@ -2,6 +2,10 @@
 
 import json
 import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +15,7 @@ from metricscenes.generate import generate
 from metricscenes.store import Collection, CollectionError
 
 pytestmark = pytest.mark.slow
+SMOKE = Path(__file__).resolve().parents[1] / "manifests" / "smoke.yaml"
 
 
 def _resolved(path):
@@ -82,6 +87,45 @@ def test_killed_run_resumes_bit_identical_with_more_workers(smoke_collection, sm
     assert (out / "groundtruth.json").read_bytes() == (smoke_collection / "groundtruth.json").read_bytes()
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux-only")
+def test_workers_die_with_a_killed_parent(tmp_path):
+    """SIGKILL of `generate --workers 2` takes its render workers with it."""
+    proc = subprocess.Popen([sys.executable, "-m", "metricscenes.cli", "generate", "--manifest", str(SMOKE),
+                             "--out", str(tmp_path / "killed"), "--workers", "2"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(_children(proc.pid)) < 2:
+        time.sleep(0.2)
+    workers = _children(proc.pid)
+    assert len(workers) >= 2, "the workers never started"
+    proc.kill()
+    proc.wait()
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and any(_alive(pid) for pid in workers):
+        time.sleep(0.2)
+    assert not any(_alive(pid) for pid in workers)
+
+
+def _children(pid: int) -> list[int]:
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and "multiprocessing" in (stat.parent / "cmdline").read_bytes().decode(errors="ignore"):
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
 def test_refuses_to_mix_manifests(smoke_collection, smoke_manifest, tmp_path):
     out = tmp_path / "mixed"
     shutil.copytree(smoke_collection, out)
@@ -104,7 +148,7 @@ def test_conditions_are_linear_mixes_of_light_groups(smoke_collection):
     c = Collection.open(smoke_collection)
     scene = c.scenes()[0].scene_id
     day, night = c.radiance(scene, "day"), c.radiance(scene, "night")
-    both = c.radiance(scene, {"sky_day": 1.0, "sky_night": 1.0, "car_lights": 1.0})
+    both = c.radiance(scene, {"sky_day": 1.0, **c.conditions["night"]})
     for a, b, ab in zip(day.layers, night.layers, both.layers):
         np.testing.assert_allclose(a.radiance + b.radiance, ab.radiance, rtol=1e-5, atol=1e-12)
     assert len(day.layers) == 2 and day.layers[1].extent.width < day.layers[0].extent.width
@@ -146,6 +190,19 @@ def test_photometry_and_illuminance_sweep(smoke_collection):
             day["mean_luminance_cd_m2"] * level / day["illuminance_at_camera_lux"], rel=1e-4)
     # E = pi L / (1 + 4 N^2) for an ideal f/2.4 lens.
     assert day["image_plane_illuminance_lux"] == pytest.approx(np.pi * day["mean_luminance_cd_m2"] / (1 + 4 * 2.4**2))
+
+
+def test_illuminance_sweep_keeps_lamps_on(smoke_collection):
+    """``lamps_on`` groups join every sweep level at weight 1, the ambient group is scaled."""
+    c = Collection.open(smoke_collection)
+    sweep = c.manifest["illuminance_sweep"]
+    c.manifest["illuminance_sweep"] = {**sweep, "lamps_on": ["car_lights", "ego_lights"]}
+    try:
+        weights = c._weights("day@1lux", 0)
+    finally:
+        c.manifest["illuminance_sweep"] = sweep
+    measured = c.resolved["illuminance_lux"]["env000"]["sky_day"]
+    assert weights == pytest.approx({"sky_day": 1.0 / measured, "car_lights": 1.0, "ego_lights": 1.0})
 
 
 def test_boxes_come_from_the_instance_mask_and_agree_with_the_projection(smoke_collection):

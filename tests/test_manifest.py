@@ -29,6 +29,8 @@ def test_packaged_manifests_validate(name):
         (lambda d: d.update(colour="blue"), "colour"),
         (lambda d: d.pop("seed"), "seed"),
         (lambda d: d.update(light_groups=["moonlight"]), "light_groups"),
+        (lambda d: d["illuminance_sweep"].update(lamps_on=["street_lights"]), "illuminance_sweep"),
+        (lambda d: d["illuminance_sweep"].update(lamps_on=["sky_day"]), "illuminance_sweep"),
     ],
 )
 def test_bad_manifest_names_the_field(change, field):

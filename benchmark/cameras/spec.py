@@ -13,7 +13,7 @@ import hashlib
 import json
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, computed_field
+from pydantic import BaseModel, ConfigDict, Field, computed_field, model_serializer, model_validator
 
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
@@ -94,13 +94,17 @@ class SensorSpec(BaseModel):
 
 
 class ExposureSpec(BaseModel):
-    """Exposure policy. ``auto_peak``: the paper's (noise-free peak voltage in the
-    central region at ``level`` of the swing); ``mean_level``: the mean voltage of the
-    central region at ``level`` of the swing; ``fixed``: ``exposure_s``."""
+    """Exposure policy (docs/camera.md, "Acquisition policies"). ``auto_peak``: the
+    paper's (noise-free peak voltage in the central region at ``level`` of the swing);
+    ``mean_level``: the mean voltage of the central region at ``level`` of the swing;
+    ``percentile``: the ``percentile``-th percentile of the central region at ``level``
+    of the swing; ``hdr``: a long and a short exposure ``hdr_ratio`` apart, merged
+    before the ISP (:mod:`benchmark.hdr`); ``fixed``: ``exposure_s``. All but ``fixed``
+    are capped at ``max_exposure_s``."""
 
     model_config = _STRICT
 
-    mode: Literal["auto_peak", "fixed", "mean_level"] = "auto_peak"
+    mode: Literal["auto_peak", "fixed", "mean_level", "percentile", "hdr"] = "auto_peak"
     level: float = Field(0.90, gt=0.0, le=1.0)
     region_fraction: float = Field(0.5, gt=0.0, le=1.0)
     """Side of the central region as a fraction of the frame's width and height."""
@@ -111,18 +115,66 @@ class ExposureSpec(BaseModel):
     exposure of the whole frame (see docs/camera.md)."""
     max_exposure_s: float = Field(0.016, gt=0.0, le=60.0)
     exposure_s: float = Field(1.0 / 60.0, gt=0.0, le=60.0)
+    percentile: float | None = Field(None, gt=0.0, le=100.0)
+    """``percentile`` mode (required there, refused elsewhere): the percentile of the
+    central region's noise-free signal put at ``level`` × swing (100: the maximum)."""
+    hdr_ratio: float = Field(16.0, gt=1.0, le=1024.0)
+    """``hdr`` mode (refused elsewhere): long / short exposure time, fixed, as in the
+    two-frame HDR of automotive sensors."""
+
+    @model_validator(mode="after")
+    def _parameters_belong_to_their_mode(self) -> "ExposureSpec":
+        if self.mode == "percentile" and self.percentile is None:
+            raise ValueError("mode 'percentile' needs 'percentile' (0 < percentile <= 100)")
+        if self.mode != "percentile" and self.percentile is not None:
+            raise ValueError(f"'percentile' applies to mode 'percentile' only, not {self.mode!r}")
+        if self.mode != "hdr" and "hdr_ratio" in self.model_fields_set:
+            raise ValueError(f"'hdr_ratio' applies to mode 'hdr' only, not {self.mode!r}")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _omit_fields_of_other_modes(self, handler):
+        # percentile and hdr_ratio came after the registry and its leaderboard: they are
+        # written only for the mode that reads them, so every earlier spec keeps its
+        # canonical JSON, hence its sha256.
+        data = handler(self)
+        if isinstance(data, dict):
+            if self.mode != "percentile":
+                data.pop("percentile", None)
+            if self.mode != "hdr":
+                data.pop("hdr_ratio", None)
+        return data
 
 
 class ISPSpec(BaseModel):
-    """Image processing: demosaic, white balance, colour matrix, output encoding."""
+    """Image processing: demosaic, white balance, colour transform, output encoding.
+
+    :func:`isp_preset` names complete settings: ``default`` (this model's defaults) and
+    ``iset-parity`` (ISETCam's default image processor, docs/camera.md)."""
 
     model_config = _STRICT
 
     demosaic: Literal["malvar2004", "bilinear"] = "malvar2004"
-    white_balance: Literal["grey_world", "known_illuminant"] = "grey_world"
+    white_balance: Literal["grey_world", "known_illuminant", "none"] = "grey_world"
+    """``none``: no gains, as ISETCam's default illuminant correction ('None')."""
     illuminant: str = "D65"
     """Illuminant for ``known_illuminant`` white balance (a colour-science name)."""
     output: Literal["srgb8", "linear"] = "srgb8"
+    color_transform: Literal["checker_srgb", "iset_mcc"] = "checker_srgb"
+    """``checker_srgb``: the ColorChecker-fitted matrix from white-balanced camera RGB to
+    linear sRGB (rows sum to 1; 1.0 = the ADC white). ``iset_mcc``: ISETCam's 'MCC
+    optimized' sensor conversion to XYZ, then display rendering scaled to the image's
+    maximum (:func:`benchmark.isp.iset_render`)."""
+
+    @model_serializer(mode="wrap")
+    def _omit_default_color_transform(self, handler):
+        # color_transform came after the registry and its leaderboard: it is written only
+        # when it is not the default, so every earlier spec keeps its canonical JSON,
+        # hence its sha256.
+        data = handler(self)
+        if isinstance(data, dict) and self.color_transform == "checker_srgb":
+            data.pop("color_transform", None)
+        return data
 
 
 class CameraSpec(BaseModel):
@@ -162,3 +214,31 @@ class CameraSpec(BaseModel):
     def sha256(self) -> str:
         """sha256 (hex) of :meth:`canonical_json`: identifies the camera in results."""
         return hashlib.sha256(self.canonical_json().encode("utf-8")).hexdigest()
+
+
+ISP_PRESETS = ("default", "iset-parity")
+"""Names accepted by :func:`isp_preset` (and ``benchmark cameras mtf --isp``)."""
+
+
+def isp_preset(name: str) -> ISPSpec:
+    """A named ISP setting.
+
+    ``default``: this project's ISP (:class:`ISPSpec` defaults: white balance on the
+    mosaic, Malvar-He-Cutler demosaic, ColorChecker matrix to linear sRGB, sRGB 8 bit).
+
+    ``iset-parity``: ISETCam's default image processor, ``ip = ipCreate`` (ISET/isetcam
+    ``imgproc/ipCreate.m``: 'transform method' adaptive, 'demosaic method' Bilinear,
+    'illuminant correction method' None, 'internal CS' XYZ, 'conversion method sensor'
+    MCC optimized) as ``ipCompute`` runs it (``imgproc/ipCompute.m``): zero level
+    subtracted, bilinear demosaic (``imgproc/demosaic/ieBilinear.m``) into 'sensor
+    space', the least-squares MCC-under-D65 transform to XYZ
+    (``imgproc/imageSensorTransform.m``), no white balance, XYZ to linear display RGB
+    scaled to the image's maximum (``displays/displayRender.m``). ISETCam's MTF
+    (``metrics/ISO/ieISO12233.m``) reads the demosaicked 'sensor space', before the
+    colour transform: see :func:`benchmark.mtf.measure_mtf50` and docs/camera.md.
+    """
+    if name == "default":
+        return ISPSpec()
+    if name == "iset-parity":
+        return ISPSpec(demosaic="bilinear", white_balance="none", color_transform="iset_mcc")
+    raise ValueError(f"unknown ISP preset {name!r} (allowed: {', '.join(ISP_PRESETS)})")

@@ -46,8 +46,9 @@ def entry_for_file(path: Path) -> ModelEntry | None:
 
 
 def default_model_dir() -> Path | None:
+    """``METRICSCENES_MODEL_DIR`` resolved against the working directory (absolute)."""
     value = os.environ.get(MODEL_DIR_ENV)
-    return Path(value) if value else None
+    return Path(value).expanduser().resolve() if value else None
 
 
 def sha256_file(path: Path) -> str:

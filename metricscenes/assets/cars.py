@@ -17,6 +17,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from metricscenes.assets import beams
 from metricscenes.assets import lamps as lamp_photometry
 from metricscenes.assets import materials
 from metricscenes.assets.car_body import BodyShape
@@ -234,9 +235,9 @@ def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, li
             wl, rad = lamp_photometry.tail_lamp(brake=lights == "brake", lens_area_m2=lr.area_m2)
         lamps.append(Lamp(lr.key, "car_lights", shape, lamp_photometry.area_emitter(wl, rad)))
         if lr.role == "head":
-            origin = lr.centre + 0.05 * lr.normal
-            target = origin + np.array([40.0, 0.0, -origin[2]])
-            wl_b, inten = lamp_photometry.headlamp_beam(spec.headlamp_kind)
-            lamps.append(Lamp(lr.key + "_beam", "car_lights", None, lamp_photometry.spot_emitter(
-                wl_b, inten, rot @ origin + m[:3, 3], rot @ target + m[:3, 3], cutoff_deg=35.0, beam_width_deg=12.0)))
+            # The low beam (minus the lens's share) as a goniometric spot aimed along the car.
+            origin = rot @ (lr.centre + 0.05 * lr.normal) + m[:3, 3]
+            lamps.append(Lamp(lr.key + "_beam", "car_lights", None, beams.head_lamp_spot(
+                "low", lamp_photometry.headlamp_spd(spec.headlamp_kind), origin, rot[:, 0],
+                lens_cd=beams.HEADLAMP_LENS_CD)))
     return SceneParts(shapes=shapes, lamps=tuple(lamps))

@@ -17,13 +17,11 @@ Luminous intensity ranges (per lamp):
 - Rear position (tail) lamp, UN ECE R7: 4-17 cd in the axis (R1 min 4, R2 max 17).
 - Stop (brake) lamp, UN ECE R7 (S1): 60-260 cd.
 - Front position lamp, UN ECE R7: 4-140 cd; daytime running lamp, UN ECE R87: 400-1200 cd.
-- Dipped (low) beam, UN ECE R112/R149: >= 5100 cd at 50V, hot spot up to 44 100 cd; towards
-  an oncoming driver (above the cut-off, point B50L) <= 350-625 cd. Seen from a camera 1.5 m
-  high in the other lane (above the cut-off) a low-beam lens therefore shows a few hundred to
-  about two thousand cd of glare (a Lambertian area emitter cannot carry the beam shape, so
-  the lens carries the glare intensity and a ``spot`` carries the beam onto the road).
-- Street lights (EN 13201 roads, 8-12 m poles): LED luminaire 4000-20 000 lm, HPS 100-250 W
-  9000-33 000 lm; peak intensities about 2000-12 000 cd (luminaire photometry files).
+- Head lamps (low and high beam) and road luminaires are goniometric: their luminous
+  intensity distributions, and the regulations and luminaire classes they follow, are in
+  :mod:`metricscenes.assets.beams`; this module gives their spectra.
+- Street lights (EN 13201 M4-M6 rural roads, 8-10 m poles): LED roadway luminaires of
+  4000-15 000 lm (IES RP-8-18 typical outputs for 30-120 W LED luminaires at ~130 lm/W).
 """
 
 from __future__ import annotations
@@ -31,6 +29,7 @@ from __future__ import annotations
 import colour
 import numpy as np
 
+from metricscenes.assets.beams import HEADLAMP_LENS_CD
 from metricscenes.assets.parts import spectrum
 from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
 
@@ -48,11 +47,9 @@ INTENSITY_RANGES_CD: dict[str, tuple[float, float, float]] = {
     "brake": (60.0, 120.0, 260.0),  # ECE R7 stop lamp S1
     "front_position": (4.0, 20.0, 140.0),  # ECE R7
     "drl": (400.0, 800.0, 1200.0),  # ECE R87
-    "headlamp_glare": (200.0, 700.0, 2000.0),  # low beam seen from an oncoming driver's eye/camera
-    "low_beam": (5100.0, 15000.0, 44100.0),  # ECE R112 50V minimum .. Emax
-    "street_led": (2000.0, 5000.0, 12000.0),
-    "street_hps": (2000.0, 6000.0, 12000.0),
 }
+STREET_LIGHT_FLUX_LM = (4000.0, 9000.0, 15000.0)
+"""(low, typical, high) rated flux of a rural road luminaire, lm."""
 
 
 def photopic_v(wavelengths_nm: np.ndarray = LAMP_NM) -> np.ndarray:
@@ -112,26 +109,18 @@ def _radiance(kind: str, intensity_cd: float, area_m2: float) -> tuple[np.ndarra
     return scaled_to_luminous(kind, intensity_cd / area_m2)
 
 
-def headlamp(kind: str = "led", lens_area_m2: float = 0.02, intensity_cd: float | None = None):
-    """Head-lamp lens: (wavelengths_nm, spectral radiance W·sr⁻¹·m⁻²·nm⁻¹) of an area emitter.
-
-    ``kind`` 'led' (5100 K) or 'halogen' (3200 K); the axial intensity defaults to the typical
-    low-beam glare towards an oncoming camera (:data:`INTENSITY_RANGES_CD` 'headlamp_glare').
-    """
+def headlamp_spd(kind: str = "led") -> str:
+    """Spectrum kind of a head lamp: 'led' (5100 K, CIE LED-B4) or 'halogen' (3200 K)."""
     spd = {"led": "led_5700k", "halogen": "halogen"}.get(kind)
     if spd is None:
         raise ValueError(f"headlamp kind must be 'led' or 'halogen', got {kind!r}")
-    cd = INTENSITY_RANGES_CD["headlamp_glare"][1] if intensity_cd is None else intensity_cd
-    return _radiance(spd, cd, lens_area_m2)
+    return spd
 
 
-def headlamp_beam(kind: str = "led", intensity_cd: float | None = None):
-    """Low-beam hot spot for a ``spot`` emitter: (wavelengths_nm, W·sr⁻¹·nm⁻¹)."""
-    spd = {"led": "led_5700k", "halogen": "halogen"}.get(kind)
-    if spd is None:
-        raise ValueError(f"headlamp kind must be 'led' or 'halogen', got {kind!r}")
-    cd = INTENSITY_RANGES_CD["low_beam"][1] if intensity_cd is None else intensity_cd
-    return scaled_to_luminous(spd, cd)
+def headlamp(kind: str = "led", lens_area_m2: float = 0.02, intensity_cd: float = HEADLAMP_LENS_CD):
+    """Head-lamp lens: (wavelengths_nm, spectral radiance W·sr⁻¹·m⁻²·nm⁻¹) of an area
+    emitter whose axial intensity is the lens's share of the beam (:mod:`beams`)."""
+    return _radiance(headlamp_spd(kind), intensity_cd, lens_area_m2)
 
 
 def tail_lamp(brake: bool = False, lens_area_m2: float = 0.02, intensity_cd: float | None = None):
@@ -140,49 +129,13 @@ def tail_lamp(brake: bool = False, lens_area_m2: float = 0.02, intensity_cd: flo
     return _radiance("red_led", cd, lens_area_m2)
 
 
-def street_light(kind: str = "led_4000k", intensity_cd: float | None = None):
-    """Street-light luminaire peak: (wavelengths_nm, spectral intensity W·sr⁻¹·nm⁻¹).
-
-    ``kind`` 'led_4000k' or 'hps'. For an area emitter of area A use radiance = intensity / A
-    (see :func:`street_light_radiance`).
-    """
-    key = {"led_4000k": "street_led", "hps": "street_hps"}.get(kind)
-    if key is None:
+def street_light_spd(kind: str = "led_4000k") -> str:
+    """Spectrum kind of a street light: 'led_4000k' (CIE LED-B3) or 'hps' (CIE HP1)."""
+    if kind not in ("led_4000k", "hps"):
         raise ValueError(f"street light kind must be 'led_4000k' or 'hps', got {kind!r}")
-    cd = INTENSITY_RANGES_CD[key][1] if intensity_cd is None else intensity_cd
-    return scaled_to_luminous(kind, cd)
-
-
-def street_light_radiance(kind: str = "led_4000k", area_m2: float = 0.15, intensity_cd: float | None = None):
-    """Street-light luminaire face as a Lambertian area emitter: (wavelengths_nm, radiance)."""
-    if area_m2 <= 0:
-        raise ValueError(f"area_m2 must be > 0, got {area_m2}")
-    wl, intensity = street_light(kind, intensity_cd)
-    return wl, intensity / area_m2
+    return kind
 
 
 def area_emitter(wavelengths_nm: np.ndarray, radiance: np.ndarray) -> dict:
     """Mitsuba ``area`` emitter dict with an irregular spectral radiance."""
     return {"type": "area", "radiance": spectrum(wavelengths_nm, radiance)}
-
-
-def spot_emitter(
-    wavelengths_nm: np.ndarray,
-    intensity: np.ndarray,
-    origin_m,
-    target_m,
-    cutoff_deg: float = 30.0,
-    beam_width_deg: float = 12.0,
-) -> dict:
-    """Mitsuba ``spot`` emitter dict (intensity W·sr⁻¹·nm⁻¹ at the beam centre)."""
-    import mitsuba as mi
-
-    return {
-        "type": "spot",
-        "intensity": spectrum(wavelengths_nm, intensity),
-        "cutoff_angle": float(cutoff_deg),
-        "beam_width": float(beam_width_deg),
-        "to_world": mi.ScalarTransform4f().look_at(
-            origin=[float(c) for c in origin_m], target=[float(c) for c in target_m], up=[0.0, 0.0, 1.0]
-        ),
-    }

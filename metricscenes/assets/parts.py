@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-LIGHT_GROUPS = ("car_lights", "street_lights")
+LIGHT_GROUPS = ("car_lights", "street_lights", "ego_lights", "ego_high_beam")
 SPECTRUM_PAD_NM = (380.0, 720.0)
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from metricscenes.assets import meshes
+from metricscenes.assets.lamps import STREET_LIGHT_FLUX_LM
 from metricscenes.assets.parts import SceneParts, mesh_shape
 from metricscenes.assets.streetlights import street_light_parts
 from metricscenes.assets.vegetation import diffuse_bsdf, tree_parts
@@ -57,7 +58,7 @@ class RoadSpec:
     light_spacing_m: float
     light_side: str  # 'left' | 'right'
     lamp_kind: str  # 'led_4000k' | 'hps'
-    lamp_intensity_cd: float
+    lamp_flux_lm: float
 
     @property
     def half_paved_m(self) -> float:
@@ -92,7 +93,7 @@ def road_spec(road_id: int) -> RoadSpec:
         light_spacing_m=round(float(rng.uniform(30.0, 40.0)), 1),
         light_side="left" if rng.uniform() < 0.5 else "right",
         lamp_kind="hps" if rng.uniform() < 0.4 else "led_4000k",
-        lamp_intensity_cd=round(float(rng.uniform(3000.0, 6500.0)), 0),
+        lamp_flux_lm=round(float(rng.uniform(*STREET_LIGHT_FLUX_LM[::2])), -1),
     )
 
 
@@ -230,5 +231,5 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0) -> ScenePart
         arm_y = pole_y - side * min(2.0 + spec.shoulder_width_m, half_paved)
         xs = np.arange(rng.uniform(8.0, 8.0 + spec.light_spacing_m), x1 - 5.0, spec.light_spacing_m)
         parts = parts.merged(street_light_parts(xs, pole_y, arm_y, height_m=float(rng.uniform(8.0, 10.0)),
-                                                kind=spec.lamp_kind, intensity_cd=spec.lamp_intensity_cd))
+                                                kind=spec.lamp_kind, flux_lm=spec.lamp_flux_lm))
     return parts
