@@ -11,7 +11,8 @@ Liu et al., EI 2023 report, for the 13 cameras:
 3. OD50 rises with MTF50 in daylight (Fig. 7A): Spearman's rho of OD50 against MTF50
    across cameras >= 0.6 (infinite OD50s rank above every finite one).
 
-:func:`paper_findings` returns each verdict (bool) with the statistic behind it (float).
+:func:`paper_findings` returns each verdict (bool) with the statistic behind it (float);
+:func:`night_findings` does the same for the night and dusk criteria of issue 10.
 """
 
 from __future__ import annotations
@@ -79,4 +80,50 @@ def paper_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day",
         "night_day_ties_at_zero": int(both_zero.sum()),
         "od50_rises_with_mtf50": bool(rho_od >= OD50_MTF50_RHO_MIN),
         "od50_mtf50_rho": rho_od,
+    }
+
+
+NIGHT_AP_25M_MIN = 0.2
+NIGHT_OD50_INSIDE_MIN_CAMERAS = 10
+
+
+def night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", dusk: str = "dusk",
+                   night: str = "night", near_m: float = 25.0,
+                   measured_range_m: tuple[float, float] = (25.0, 200.0)) -> dict[str, bool | float | int]:
+    """Issue 10's night criteria on a sweep's tables (every camera of the table):
+
+    - ``night_ap_near_useful``: night AP at ``near_m`` >= 0.2 for every camera
+      (``night_ap_near_min``: the smallest);
+    - ``night_below_day_everywhere``: night AP < day AP at every distance, every camera
+      (ties at zero count against it here: a blind camera is not "below");
+    - ``night_ap_falls_with_distance``: Spearman rho of night AP vs distance <= -0.8 for
+      every camera (``night_rho_worst``; a constant AP gives NaN and fails);
+    - ``night_od50_inside``: night OD50 inside ``measured_range_m`` for >= 10 cameras
+      (``night_od50_inside_cameras``: how many);
+    - ``dusk_between_at_near``: night < dusk <= day AP at ``near_m`` for every camera
+      (dusk may match day; ``dusk_between_cameras``: how many).
+    """
+    def ap(condition: str) -> pd.DataFrame:
+        rows = table[table["condition"] == condition]
+        if rows.empty:
+            raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
+        return rows.pivot_table(index="camera", columns="distance_m", values="ap")
+
+    ap_day, ap_dusk, ap_night = ap(day), ap(dusk), ap(night)
+    rhos = ap_distance_rho(table, night).to_numpy()
+    worst = float(np.max(rhos)) if not np.any(np.isnan(rhos)) else float("nan")
+    od_night = od50[od50["condition"] == night]["od50_m"].astype(float)
+    inside = int(((od_night >= measured_range_m[0]) & (od_night <= measured_range_m[1])).sum())
+    near_night, near_dusk, near_day = ap_night[near_m], ap_dusk[near_m], ap_day[near_m]
+    between = (near_night < near_dusk) & (near_dusk <= near_day)
+    return {
+        "night_ap_near_useful": bool((near_night >= NIGHT_AP_25M_MIN).all()),
+        "night_ap_near_min": float(near_night.min()),
+        "night_below_day_everywhere": bool((ap_night < ap_day).to_numpy().all()),
+        "night_ap_falls_with_distance": bool(worst <= AP_DISTANCE_RHO_MAX),
+        "night_rho_worst": worst,
+        "night_od50_inside": inside >= NIGHT_OD50_INSIDE_MIN_CAMERAS,
+        "night_od50_inside_cameras": inside,
+        "dusk_between_at_near": bool(between.all()),
+        "dusk_between_cameras": int(between.sum()),
     }

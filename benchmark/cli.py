@@ -50,10 +50,11 @@ def run(
     from benchmark.cameras import load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.exposure import format_exposure, parse_exposure, with_exposure
-    from benchmark.run import run_camera
+    from benchmark.run import check_out_dir, run_camera
     from metricscenes.store import Collection, CollectionError
 
     try:
+        check_out_dir(out)
         policy = parse_exposure(exposure) if exposure is not None else None
         cam = with_exposure(load_camera(camera), policy)
         col = Collection.open(collection)
@@ -65,8 +66,11 @@ def run(
     with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TimeElapsedColumn(), TimeRemainingColumn(), console=err) as bar:
         task = bar.add_task(f"{cam.name} · {condition}", total=len(col.scenes()))
-        results = run_camera(col, cam, condition, detector, out, seed=seed, save_images=save_images,
-                             backend=backend, progress=lambda done, total: bar.update(task, completed=done))
+        try:  # a damaged array is found when it is read: no results are written
+            results = run_camera(col, cam, condition, detector, out, seed=seed, save_images=save_images,
+                                 backend=backend, progress=lambda done, total: bar.update(task, completed=done))
+        except (ValueError, CollectionError) as exc:
+            fail(str(exc).splitlines()[0])
     title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
@@ -101,9 +105,11 @@ def sweep(
     from benchmark.cameras import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.exposure import format_exposure, parse_exposure
+    from benchmark.run import check_out_dir
     from metricscenes.store import Collection, CollectionError
 
     try:
+        check_out_dir(out)
         policy = parse_exposure(exposure) if exposure is not None else None
         names = camera_names() if cameras.strip().lower() == "all" else [c.strip() for c in cameras.split(",") if c.strip()]
         cams = [load_camera(name) for name in names]

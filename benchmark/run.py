@@ -23,6 +23,32 @@ import numpy as np
 
 RESULTS_FORMAT = "metricscenes-results/1"
 AP_SCORE_THRESHOLD = 0.001  # COCO evaluation wants the whole precision-recall curve
+# What a name that becomes a file or folder name may not hold (one rule for all of them):
+# a way out of its folder, a separator on any OS, or characters that break a line or a C string.
+FORBIDDEN_IN_NAMES = ("..", "/", "\\", "\0", "\n", "\r")
+
+
+def check_path_name(name: str, what: str) -> str:
+    """``name`` if it can name one folder or file: not empty, no ``..``, ``/``, ``\\``,
+    NUL or newline; else a one-line ValueError naming ``what`` it is."""
+    if not isinstance(name, str) or not name or any(bad in name for bad in FORBIDDEN_IN_NAMES):
+        raise ValueError(f"{what} {name!r} cannot name a folder (it must be non-empty, without '..', '/', "
+                         "'\\', NUL or newline)")
+    return name
+
+
+def check_out_dir(out_dir) -> Path:
+    """An output folder for benchmark: its own name follows :func:`check_path_name`, and
+    it is not a collection nor inside one (collections are read-only to benchmark)."""
+    from metricscenes.store import collection_containing
+
+    out_dir = Path(out_dir)
+    check_path_name(out_dir.name, "--out folder name")  # as typed: 'runs/..' and '.' name no folder
+    inside = collection_containing(out_dir)
+    if inside is not None:
+        raise ValueError(f"--out {out_dir} is inside the collection {inside}: collections are read-only to "
+                         "benchmark, choose a folder outside it")
+    return out_dir
 
 
 @dataclass
@@ -59,7 +85,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     from metricscenes import __version__
     from metricscenes.groundtruth import scale_groundtruth
 
-    out_dir = Path(out_dir)
+    out_dir = check_out_dir(out_dir)  # before anything is written
     (out_dir / "images" if save_images else out_dir).mkdir(parents=True, exist_ok=True)
     scenes = collection.scenes()
     timings = Timings()

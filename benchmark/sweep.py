@@ -52,7 +52,14 @@ Progress = Callable[[int, int, str], None]
 
 def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) -> str:
     """Folder name of one run under ``out_dir/runs`` (``exposure_tag``: the overriding
-    exposure policy's :func:`benchmark.exposure.exposure_tag`)."""
+    exposure policy's :func:`benchmark.exposure.exposure_tag`). Its parts come from camera
+    files and collection manifests, so each must pass :func:`benchmark.run.check_path_name`."""
+    from benchmark.run import check_path_name
+
+    check_path_name(camera_name, "camera name")
+    check_path_name(condition, "condition")
+    if exposure_tag:
+        check_path_name(exposure_tag, "exposure tag")
     return f"{camera_name}-{condition}" + (f"+{exposure_tag}" if exposure_tag else "")
 
 
@@ -183,7 +190,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     names = [c.name for c in cameras]
     if len(set(names)) != len(names):
         raise ValueError(f"camera names must be unique, got {names}")
-    out_dir = Path(out_dir)
+    for camera in cameras:  # every run folder name is valid before anything is written
+        for condition in conditions:
+            run_name(camera.name, condition, tags[camera.name])
+    out_dir = run_module.check_out_dir(out_dir)
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
     n_scenes = len(collection.scenes())

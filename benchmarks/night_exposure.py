@@ -5,12 +5,11 @@ and what sets the exposure (the central region's brightest pixels).
         --cameras cam12 cam08 --condition night [--exposure percentile:50] --out docs/data/night-exposure.csv
 
 For every scene the camera simulation runs without temporal noise; per scene it writes
-the exposure time (s), the median signal electrons of the green pixels inside the car's
+the car's heading, the exposure time (ms), the median signal electrons of the green pixels inside the car's
 ground-truth box, the same in the central region (the exposure policy's window), the
 central region's 99.9th percentile and its ratio to the region's median, and which
 fraction of the region is within a factor 2 of that peak (lamps, glare). A histogram of
-log10 electrons in the central region is drawn for the first scene at each distance
-(``--histograms``).
+log10 electrons in the central region is drawn for a few scenes (``--histograms``).
 """
 
 from __future__ import annotations
@@ -38,9 +37,34 @@ def green_sites(electrons: np.ndarray, rows: slice, cols: slice) -> np.ndarray:
     return electrons[win & green]
 
 
+def central_histograms(collection: Collection, camera, condition: str, scene_ids: list[str], path: Path) -> None:
+    """Histograms of log10 signal electrons in the central region, one line per scene, with
+    the reference policy's peak (the 99.9th percentile) marked."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 3.6))
+    bins = np.linspace(-3, 3.5, 131)
+    for sid in scene_ids:
+        e = simulate(collection.radiance(sid, condition), camera, seed=0, noise=False).electrons
+        region = e[central_region(e.shape, camera.exposure.region_fraction)]
+        line, = ax.plot(bins[:-1], np.histogram(np.log10(np.maximum(region, 1e-3)), bins)[0] / region.size,
+                        drawstyle="steps-post", label=sid)
+        ax.axvline(np.log10(np.percentile(region, 99.9)), color=line.get_color(), ls=":", lw=1)
+    ax.set_yscale("log")
+    ax.set_xlabel("log10 signal electrons (noise-free) in the central region")
+    ax.set_ylabel("fraction of pixels")
+    ax.set_title(f"{camera.name}, {condition}, {camera.exposure.mode}: dotted = 99.9th percentile")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def scene_rows(collection: Collection, camera, condition: str) -> list[dict]:
     gt = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px)
     boxes = {a["image_id"]: a["bbox"] for a in gt["annotations"]}
+    heading = {im["id"]: im["heading"] for im in gt["images"]}
     out = []
     for scene in collection.scenes():
         capture = simulate(collection.radiance(scene.scene_id, condition), camera, seed=0, noise=False)
@@ -51,7 +75,7 @@ def scene_rows(collection: Collection, camera, condition: str) -> list[dict]:
         peak = float(np.percentile(region, 99.9))
         out.append({
             "camera": camera.name, "condition": condition, "exposure_mode": camera.exposure.mode,
-            "scene_id": scene.scene_id, "distance_m": scene.distance_m,
+            "scene_id": scene.scene_id, "heading": heading[scene.image_id], "distance_m": scene.distance_m,
             "exposure_ms": round(1e3 * capture.exposure_s, 4),
             "car_median_e": round(float(np.median(car)), 2),
             "region_median_e": round(float(np.median(region)), 3),
@@ -69,20 +93,25 @@ def main() -> None:
     parser.add_argument("--condition", default="night")
     parser.add_argument("--exposure", default=None, help="an acquisition policy, as `benchmark run --exposure`")
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--histograms", type=Path, default=None,
+                        help="also draw central-region histograms of these scenes' first camera (PNG)")
+    parser.add_argument("--scenes", nargs="+", default=["env000-d025m", "env000-d100m", "env001-d025m", "env001-d100m"])
     args = parser.parse_args()
     collection = Collection.open(args.collection)
     rows = []
+    if args.histograms:
+        central_histograms(collection, load_camera(args.cameras[0]), args.condition, args.scenes, args.histograms)
     for name in args.cameras:
         camera = load_camera(name)
         if args.exposure:
             camera = with_exposure(camera, parse_exposure(args.exposure))
         rows += scene_rows(collection, camera, args.condition)
-        by_d: dict[float, list[dict]] = {}
+        groups: dict[tuple, list[dict]] = {}
         for r in rows:
             if r["camera"] == name:
-                by_d.setdefault(r["distance_m"], []).append(r)
-        for d, rs in sorted(by_d.items()):
-            print(f"{name} {args.condition} {d:5.0f} m: exposure {np.median([r['exposure_ms'] for r in rs]):7.3f} ms, "
+                groups.setdefault((r["heading"], r["distance_m"]), []).append(r)
+        for (head, d), rs in sorted(groups.items()):
+            print(f"{name} {args.condition} {head:8s} {d:5.0f} m: exposure {np.median([r['exposure_ms'] for r in rs]):7.3f} ms, "
                   f"car {np.median([r['car_median_e'] for r in rs]):8.2f} e-, "
                   f"peak/median {np.median([r['peak_over_median'] for r in rs]):8.1f}")
     args.out.parent.mkdir(parents=True, exist_ok=True)

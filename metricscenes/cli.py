@@ -73,7 +73,8 @@ def generate(
             def progress(done: int, total: int, key: str | None) -> None:
                 bar.update(task, completed=done, total=total, description=f"rendering {key or m.name}")
 
-            run_generate(m, out, workers=workers, threads=threads, progress=progress)
+            run_generate(m, out, workers=workers, threads=threads, progress=progress,
+                         notice=lambda line: err.print(line, highlight=False, soft_wrap=True))
         seconds = time.perf_counter() - started
         if as_json:
             print(json.dumps({"collection": str(out), "seconds": round(seconds, 2)}))
@@ -147,16 +148,16 @@ def _photometry_table(rows: list[dict]) -> None:
 
 @app.command()
 def verify(collection: Annotated[Path, typer.Argument(help="collection folder")]) -> None:
-    """Recompute every array's sha256 against manifest.resolved.yaml."""
-    from metricscenes.store import Collection
+    """Check the whole collection: resolved manifest, every array's sha256 (masks too), ground truth."""
+    from metricscenes.store import verify_collection
 
-    try:
-        bad = Collection.open(collection).verify()
-    except _user_errors() as exc:
-        fail(str(exc))
-    if bad:
-        fail(f"{len(bad)} array(s) do not match their sha256, first: {bad[0]}", code=1)
-    console.print("all arrays match their sha256")
+    problems = verify_collection(collection)
+    for line in problems:
+        console.print(f"bad: {line}", highlight=False, soft_wrap=True)
+    if problems:
+        fail(f"{collection}: {len(problems)} problem(s); rerun `metricscenes generate` with its manifest to repair it",
+             code=1)
+    console.print("manifest, arrays and ground truth match their records")
 
 
 @app.command()

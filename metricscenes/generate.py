@@ -4,13 +4,16 @@ Units of work are the plates (one per environment: its background without the ca
 once per light group) and the insets (one per scene: a window around the car at
 finer angular sampling, once per light group, plus a whole frame of the car's own
 lamps at plate sampling, since their light reaches far beyond the window). Each unit writes its own zarr arrays
-and then a small record under ``progress/``; a rerun skips units whose record exists,
-so a killed run resumes, and because every unit is a pure function of the manifest
-the result is bit-identical to an uninterrupted run, whatever the number of workers.
+and then a small record under ``progress/``; a rerun skips units whose record exists
+and whose arrays still match the record's sha256 (a damaged or deleted array is
+rendered again), so a killed run resumes and a damaged collection is repaired, and
+because every unit is a pure function of the manifest the result is bit-identical to
+an uninterrupted run, whatever the number of workers.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -29,8 +32,8 @@ from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco
 from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.store import (
-    GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, write_atomic,
-    write_mask, write_radiance,
+    GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, read_checked,
+    resolved_content_sha256, write_atomic, write_mask, write_radiance,
 )
 
 # Margins of the inset window around the car's projected box, as fractions of the box:
@@ -154,7 +157,7 @@ def _ground_truth(manifest: Manifest, unit: Unit, root: Path, env_parts, parts, 
     mask_box = mask_box_tan(mask, extent)
     if mask_box is None:
         raise RenderError(f"{unit.key}: the car is not visible in its inset")
-    write_mask(root, unit.key, mask, extent)
+    record["arrays"][f"masks/{unit.key}"] = write_mask(root, unit.key, mask, extent)
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     return {"box_tan": list(mask_box), "mask_iou": round(box_iou(mask_box, record["projected_box_tan"]), 4),
             "bbox_xywh": box_tan_to_xywh(mask_box, ref_w, ref_h)}
@@ -170,6 +173,29 @@ def _load_record(root: Path, key: str) -> dict | None:
     except (OSError, json.JSONDecodeError):
         return None  # absent or torn: redo the unit
     return record if record.get("unit") == key else None
+
+
+def _record_problem(root: Path, group, record: dict, manifest: Manifest) -> str | None:
+    """Why a finished unit must be rendered again (an array missing, unreadable or not
+    the bytes its record names; a mask that does not give the recorded box), or None:
+    the progress record is a claim, not proof."""
+    key = record["unit"]
+    try:
+        for path, sha in sorted(record["arrays"].items()):
+            read_checked(root, group, path, sha, key)
+        if record["kind"] == "inset":  # the box goes into groundtruth.json: it must be the mask's
+            path = f"masks/{key}"  # (records written before masks had a sha256 have none for it)
+            mask, attrs = read_checked(root, group, path, record["arrays"].get(path), key)
+            box = mask_box_tan(mask.astype(bool), TanExtent(*attrs["extent_tan"]))
+            grid = manifest.reference_grid
+            if (box is None or list(box) != record["box_tan"]
+                    or box_tan_to_xywh(box, grid.width_px, grid.height_px) != record["bbox_xywh"]):
+                return f"{key}: masks/{key} does not give the recorded box"
+    except CollectionError as exc:
+        return str(exc)
+    except (KeyError, TypeError, AttributeError, ValueError):
+        return f"{key}: its progress record is incomplete"
+    return None
 
 
 def _prepare(root: Path, manifest: Manifest) -> None:
@@ -191,18 +217,29 @@ def _prepare(root: Path, manifest: Manifest) -> None:
 
 
 def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threads: int | None = None,
-             progress=None) -> Path:
-    """Render ``manifest`` into ``out_dir`` (resuming what is already done).
+             progress=None, notice=None) -> Path:
+    """Render ``manifest`` into ``out_dir`` (resuming what is already done, repairing
+    what is damaged).
 
     ``workers`` processes render units in parallel; each uses ``threads`` render
     threads (default: the CPU count divided by the workers). ``progress`` is an
-    optional callable ``(done, total, unit_key)``.
+    optional callable ``(done, total, unit_key)``; ``notice`` an optional callable that
+    gets one line per finished unit found damaged (it is rendered again).
     """
+    import zarr
+
     root = Path(out_dir)
     _prepare(root, manifest)
     scenes = plan_collection(manifest)
     units = plan_units(scenes)
     records = {u.key: _load_record(root, u.key) for u in units}
+    group = zarr.open_group(str(root / RADIANCE_STORE), mode="r")
+    for key, record in records.items():
+        problem = None if record is None else _record_problem(root, group, record, manifest)
+        if problem:
+            records[key] = None
+            if notice:
+                notice(f"rendering {key} again: {problem}")
     todo = [u for u in units if records[u.key] is None]
     threads = threads or max(1, (os.cpu_count() or 1) // max(1, workers))
     manifest_json = manifest.model_dump(mode="json")
@@ -260,7 +297,7 @@ def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: 
         boxes.append(rec["bbox_xywh"])
     info = {"description": f"metricscenes collection {manifest.name}", "version": __version__,
             "protocol": manifest.protocol, "manifest_sha256": manifest.sha256()}
-    gt = coco_groundtruth(images, boxes, info)
+    gt_text = json.dumps(coco_groundtruth(images, boxes, info), indent=1)
     arrays = {path: sha for key in sorted(records) for path, sha in sorted(records[key]["arrays"].items())}
     resolved = {
         "package_version": __version__,
@@ -268,9 +305,13 @@ def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: 
         "manifest": manifest.model_dump(mode="json"),
         "arrays": arrays,
         # Horizontal illuminance at the camera (0, 0, 1.5 m) per environment and light group.
-        "illuminance_lux": {key: records[key].get("illuminance_lux", {}) for key in sorted(records)
-                            if records[key]["kind"] == "plate"},
+        # (sorted: a record read back from progress/ has sorted keys, one just rendered has not)
+        "illuminance_lux": {key: dict(sorted(records[key].get("illuminance_lux", {}).items()))
+                            for key in sorted(records) if records[key]["kind"] == "plate"},
         "plan": [s.summary() for s in scenes],
+        "groundtruth_sha256": hashlib.sha256(gt_text.encode()).hexdigest(),
     }
-    write_atomic(root / GROUNDTRUTH_FILE, json.dumps(gt, indent=1))
+    # Last, over all of the above: an edited illuminance or hash is caught on open.
+    resolved["content_sha256"] = resolved_content_sha256(resolved)
+    write_atomic(root / GROUNDTRUTH_FILE, gt_text)
     write_atomic(root / RESOLVED_MANIFEST_FILE, yaml.safe_dump(resolved, sort_keys=False))

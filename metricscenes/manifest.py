@@ -120,8 +120,14 @@ class Manifest(_Strict):
 
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
-        canonical = json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(canonical.encode()).hexdigest()
+        return canonical_sha256(self.model_dump(mode="json"))
+
+
+def canonical_sha256(data) -> str:
+    """sha256 of plain data's canonical JSON form (sorted keys, no spaces): the same value
+    for a manifest and for its copy read back from a collection's YAML."""
+    canonical = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()
 
 
 def parse_manifest(data: object, source: str = "manifest") -> Manifest:

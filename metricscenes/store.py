@@ -9,12 +9,20 @@ Layout of a collection folder::
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, sha256 of every array
+                                        (masks too), of groundtruth.json and of its own content
     progress/<unit>.json                one record per finished unit of work (resume)
 
 Every array is one chunk written by one unit of work, so workers never share a file.
 Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)
 and ``light_group``. A light group that puts no light in a unit (e.g. street lights
-on a road without any) has no array: it reads as zero.
+on a road without any) has no array: it reads as zero. Which arrays a unit has is
+what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
+
+Integrity: every array is checked against its recorded sha256 when it is first read
+(once per process and file version, :func:`read_checked`), so a damaged, truncated or
+deleted chunk is an error, never wrong numbers or fill-value zeros. Collections written
+before masks and ground truth had a sha256 are still read: their ground-truth boxes are
+recomputed from the masks instead.
 """
 
 from __future__ import annotations
@@ -29,6 +37,7 @@ import numpy as np
 import yaml
 
 from metricscenes.geometry import TanExtent
+from metricscenes.manifest import canonical_sha256
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
 
@@ -37,10 +46,19 @@ GROUNDTRUTH_FILE = "groundtruth.json"
 RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
 PROGRESS_DIR = "progress"
 DIMENSIONS = ("y", "x", "wavelength")
+REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
+# Arrays are always written with their chunk, even an all-zero one, so that a missing
+# chunk file is damage (zarr would otherwise read it as fill-value zeros).
+WRITE_CONFIG = {"write_empty_chunks": True}
 
 
 class CollectionError(ValueError):
     """A collection folder is missing, incomplete or corrupted (one-line message)."""
+
+
+# Arrays that matched their sha256 in this process, by file version (see _fingerprint):
+# reading a plate shared by six scenes, or a scene under several conditions, hashes it once.
+_CHECKED: set[tuple] = set()
 
 
 def array_sha256(array: np.ndarray) -> str:
@@ -49,6 +67,81 @@ def array_sha256(array: np.ndarray) -> str:
     h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
     h.update(a.tobytes())
     return h.hexdigest()
+
+
+def resolved_content_sha256(resolved: dict) -> str:
+    """sha256 of a resolved manifest's content, its own ``content_sha256`` left out."""
+    return canonical_sha256({k: v for k, v in resolved.items() if k != "content_sha256"})
+
+
+def _fingerprint(root: Path, path: str) -> tuple:
+    """What identifies one version of an array's files: names, inodes, sizes, mtimes."""
+    folder = root / RADIANCE_STORE / path
+    files = []
+    for p in sorted(folder.rglob("*")):
+        if p.is_file():
+            st = p.stat()
+            files.append((str(p.relative_to(folder)), st.st_ino, st.st_size, st.st_mtime_ns))
+    return (str(folder.resolve()), *files)
+
+
+def read_checked(root: Path, group, path: str, expected: str | None, label: str) -> tuple[np.ndarray, dict]:
+    """Read one array of a collection and its attributes; check it against ``expected``
+    (its recorded sha256; None for masks of older collections, which have none).
+
+    Raises :class:`CollectionError` ``"<label>: <path> <what is wrong>"`` if the array is
+    missing, unreadable, or not the bytes that were written (a deleted chunk reads as
+    fill values, so it fails the hash too).
+    """
+    import zarr
+
+    try:
+        node = group[path]
+    except KeyError:
+        raise CollectionError(f"{label}: {path} is missing") from None
+    except Exception as exc:  # its zarr.json is damaged
+        raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
+    if not isinstance(node, zarr.Array):
+        raise CollectionError(f"{label}: {path} is missing (a group is in its place)")
+    fingerprint = _fingerprint(root, path) + (expected,)
+    try:
+        data = np.asarray(node[...])
+        attrs = dict(node.attrs)
+    except Exception as exc:  # zstd, numcodecs and zarr raise many types for a damaged chunk
+        raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
+    if expected is not None and fingerprint not in _CHECKED:
+        if array_sha256(data) != expected:
+            has_chunk = any(name != "zarr.json" for name, *_ in fingerprint[1:-1])
+            raise CollectionError(f"{label}: {path} does not match its sha256"
+                                  + ("" if has_chunk else " (its chunk is missing)"))
+        _CHECKED.add(fingerprint)
+    return data, attrs
+
+
+def _extent(attrs: dict, label: str, path: str) -> TanExtent:
+    try:
+        return TanExtent(*(float(v) for v in attrs["extent_tan"]))
+    except (KeyError, TypeError, ValueError):
+        raise CollectionError(f"{label}: {path} has no valid extent_tan attribute") from None
+
+
+def mask_box_xywh(mask: np.ndarray, extent: TanExtent, width_px: int, height_px: int) -> list[float] | None:
+    """The COCO box a mask gives on the reference grid, exactly as ``generate`` computes it."""
+    from metricscenes.groundtruth import box_tan_to_xywh, mask_box_tan
+
+    box = mask_box_tan(np.asarray(mask, dtype=bool), extent)
+    return None if box is None else box_tan_to_xywh(box, width_px, height_px)
+
+
+def collection_containing(path: str | Path) -> Path | None:
+    """The collection folder that ``path`` is (or lies inside), or None. A folder is a
+    collection if it holds a resolved manifest, a radiance store or a generate stamp."""
+    p = Path(os.path.abspath(Path(path).expanduser())).resolve()
+    for folder in (p, *p.parents):
+        if ((folder / RESOLVED_MANIFEST_FILE).is_file() or (folder / RADIANCE_STORE).is_dir()
+                or (folder / PROGRESS_DIR / "manifest_sha256").is_file()):
+            return folder
+    return None
 
 
 def write_atomic(path: Path, text: str) -> None:
@@ -74,22 +167,24 @@ def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.
     arr = zarr.create_array(
         store=str(root / RADIANCE_STORE), name=f"{kind}/{unit}/{light_group}", shape=cube.shape,
         dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
-        overwrite=True,
+        overwrite=True, config=WRITE_CONFIG,
     )
     arr[...] = cube
     return array_sha256(cube)
 
 
-def write_mask(root: Path, unit: str, mask: np.ndarray, extent: TanExtent) -> None:
-    """Write a scene's instance mask (True = car) over its inset window."""
+def write_mask(root: Path, unit: str, mask: np.ndarray, extent: TanExtent) -> str:
+    """Write a scene's instance mask (True = car) over its inset window; return its sha256."""
     import zarr
 
+    mask = np.ascontiguousarray(mask, dtype=bool)
     arr = zarr.create_array(
         store=str(root / RADIANCE_STORE), name=f"masks/{unit}", shape=mask.shape, dtype="bool",
-        chunks=mask.shape, dimension_names=("y", "x"), overwrite=True,
+        chunks=mask.shape, dimension_names=("y", "x"), overwrite=True, config=WRITE_CONFIG,
         attributes={"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"},
     )
     arr[...] = mask
+    return array_sha256(mask)
 
 
 @dataclass(frozen=True)
@@ -105,12 +200,23 @@ class SceneRecord:
 class Collection:
     """A rendered collection, opened read-only. Use :meth:`open`."""
 
-    def __init__(self, root: Path, resolved: dict, groundtruth: dict):
+    def __init__(self, root: Path, resolved: dict, groundtruth: dict, groundtruth_sha256: str | None = None):
         self.root = root
         self.resolved = resolved
         self._groundtruth = groundtruth
+        self._groundtruth_sha256 = groundtruth_sha256
         self._images = {img["scene_id"]: img for img in groundtruth["images"]}
+        self._boxes: dict[int, list] = {}
+        for ann in groundtruth["annotations"]:
+            self._boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
         self._zarr = None
+        # The light groups of each plate, inset and frame, as recorded (sorted: float sums
+        # are not associative); a recorded array that is absent is an error, not a zero.
+        self._recorded: dict[str, list[str]] = {}
+        for path in sorted(resolved["arrays"]):
+            parts = path.split("/")
+            if len(parts) == 3:
+                self._recorded.setdefault(f"{parts[0]}/{parts[1]}", []).append(parts[2])
 
     @classmethod
     def open(cls, path: str | Path) -> "Collection":
@@ -122,14 +228,12 @@ class Collection:
                 raise CollectionError(
                     f"{root}: not a complete collection ({name} is missing; rerun `metricscenes generate` to finish it)"
                 )
-        try:
-            resolved = yaml.safe_load((root / RESOLVED_MANIFEST_FILE).read_text())
-            groundtruth = json.loads((root / GROUNDTRUTH_FILE).read_text())
-        except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise CollectionError(f"{root}: corrupted metadata ({type(exc).__name__})") from None
-        if not isinstance(resolved, dict) or "manifest" not in resolved or "arrays" not in resolved:
-            raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} lacks 'manifest' or 'arrays'")
-        return cls(root, resolved, groundtruth)
+        collection = cls(root, _load_resolved(root), *_load_groundtruth(root))
+        problems = collection._groundtruth_problems()
+        if problems:
+            more = f" (and {len(problems) - 1} more: run `metricscenes verify {root}`)" if len(problems) > 1 else ""
+            raise CollectionError(f"{root}: {problems[0]}{more}; {REPAIR_HINT}")
+        return collection
 
     # --- facts -------------------------------------------------------------------------
     @property
@@ -231,29 +335,58 @@ class Collection:
             raise CollectionError(f"unknown scene {scene_id!r}")
         return self._images[scene_id]
 
-    def _mix(self, kind: str, unit: str, weights: dict[str, float], required: bool = True) -> RadianceLayer | None:
-        group = self._group()
-        path = f"{kind}/{unit}"
-        if path not in group:
+    def _read(self, path: str, scene_id: str) -> tuple[np.ndarray, dict]:
+        """One array, checked against its recorded sha256 (a one-line error naming the scene)."""
+        try:
+            return read_checked(self.root, self._group(), path, self.resolved["arrays"].get(path), f"scene {scene_id}")
+        except CollectionError as exc:
+            raise CollectionError(f"{self.root}: {exc}; {REPAIR_HINT}") from None
+
+    def _mix(self, kind: str, unit: str, weights: dict[str, float], scene_id: str,
+             required: bool = True) -> RadianceLayer | None:
+        groups = self._recorded.get(f"{kind}/{unit}", [])
+        if not groups:
             if not required:
                 return None
-            raise CollectionError(f"{self.root}: {path} is missing from {RADIANCE_STORE}")
-        node = group[path]
+            raise CollectionError(f"{self.root}: scene {scene_id}: {kind}/{unit} has no arrays in {RESOLVED_MANIFEST_FILE}")
         total, extent = None, None
-        for light_group in sorted(node.array_keys()):  # a fixed order: float sums are not associative
-            arr = node[light_group]
-            extent = TanExtent(*arr.attrs["extent_tan"])
+        for light_group in groups:
             w = weights.get(light_group, 0.0)
             if w == 0.0:
                 continue
-            cube = np.asarray(arr[...], dtype=np.float32) * np.float32(w)
+            path = f"{kind}/{unit}/{light_group}"
+            data, attrs = self._read(path, scene_id)
+            extent = _extent(attrs, f"{self.root}: scene {scene_id}", path)
+            cube = np.asarray(data, dtype=np.float32) * np.float32(w)
             total = cube if total is None else total + cube
-        if extent is None:
-            return None
-        if total is None:
-            arr = node[min(node.array_keys())]
+        if total is None:  # no group of this unit is lit: zeros on its grid (metadata only)
+            path = f"{kind}/{unit}/{groups[0]}"
+            arr = self._node(path, scene_id)
+            extent = _extent(dict(arr.attrs), f"{self.root}: scene {scene_id}", path)
             total = np.zeros(arr.shape, dtype=np.float32)
         return RadianceLayer(total, extent)
+
+    def _node(self, path: str, scene_id: str):
+        """An array's metadata (shape, attributes) without reading its data."""
+        try:
+            return self._group()[path]
+        except Exception:
+            raise CollectionError(f"{self.root}: scene {scene_id}: {path} is missing or unreadable; {REPAIR_HINT}") from None
+
+    def mask(self, scene_id: str) -> tuple[np.ndarray, TanExtent]:
+        """The car's instance mask over its inset window and that window's extent, checked
+        against its sha256 (where recorded) and against the scene's ground-truth box."""
+        img = self._image(scene_id)
+        path = f"masks/{scene_id}"
+        data, attrs = self._read(path, scene_id)
+        extent = _extent(attrs, f"{self.root}: scene {scene_id}", path)
+        problem = _box_problem(img, self._boxes.get(img["id"], []), data, extent)
+        if problem:
+            raise CollectionError(f"{self.root}: {problem}; {REPAIR_HINT}")
+        return data.astype(bool, copy=False), extent
+
+    def _groundtruth_problems(self) -> list[str]:
+        return groundtruth_problems(self.root, self._group(), self._groundtruth, self._groundtruth_sha256, self.resolved)
 
     def radiance(self, scene_id: str, condition: str | dict[str, float]) -> SpectralScene:
         """The scene's spectral radiance under a condition (a name from the manifest, or
@@ -261,13 +394,12 @@ class Collection:
         light groups' renders."""
         img = self._image(scene_id)
         weights = self._weights(condition, img["environment_id"])
-        plate = self._mix("plates", f"env{img['environment_id']:03d}", weights)
-        if plate is None:
-            raise CollectionError(f"{self.root}: scene {scene_id} has no plate")
-        frame = self._mix("frames", scene_id, weights, required=False)
+        self.mask(scene_id)  # a scene is read whole or not at all: its mask and box too
+        plate = self._mix("plates", f"env{img['environment_id']:03d}", weights, scene_id)
+        frame = self._mix("frames", scene_id, weights, scene_id, required=False)
         if frame is not None:
             plate = RadianceLayer(plate.radiance + frame.radiance, plate.extent)
-        inset = self._mix("insets", scene_id, weights)
+        inset = self._mix("insets", scene_id, weights, scene_id)
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
         return SpectralScene(
             layers=layers,
@@ -279,24 +411,162 @@ class Collection:
         """Per layer (plate, inset): its extent in tangent coordinates and its sampling in mrad per pixel."""
         env = self._image(scene_id)["environment_id"]
         out = []
-        for name, path in (("plate", f"plates/env{env:03d}"), ("inset", f"insets/{scene_id}")):
-            node = self._group()[path]
-            arr = node[min(node.array_keys())]  # every light group of a unit shares its grid
-            extent = TanExtent(*arr.attrs["extent_tan"])
+        for name, unit in (("plate", f"plates/env{env:03d}"), ("inset", f"insets/{scene_id}")):
+            groups = self._recorded.get(unit)
+            if not groups:
+                raise CollectionError(f"{self.root}: scene {scene_id}: {unit} has no arrays in {RESOLVED_MANIFEST_FILE}")
+            path = f"{unit}/{groups[0]}"  # every light group of a unit shares its grid
+            arr = self._node(path, scene_id)
+            extent = _extent(dict(arr.attrs), f"{self.root}: scene {scene_id}", path)
             rows, cols = arr.shape[:2]
             out.append({"layer": name, "extent_tan": extent.as_tuple(), "shape": arr.shape,
                         "mrad_per_px": (1e3 * extent.width / cols, 1e3 * extent.height / rows)})
         return out
 
     def verify(self) -> list[str]:
-        """Recompute every array's sha256; return the paths whose content does not match."""
-        bad = []
-        group = self._group()
-        for path, expected in sorted(self.resolved["arrays"].items()):
-            try:
-                actual = array_sha256(np.asarray(group[path][...]))
-            except Exception:  # missing or unreadable chunk
-                actual = None
-            if actual != expected:
-                bad.append(path)
-        return bad
+        """Every problem of the collection, one line each naming its scene (or plate)."""
+        return verify_collection(self.root)
+
+
+def _box_problem(img: dict, boxes: list, mask: np.ndarray, extent: TanExtent) -> str | None:
+    """Is ``boxes`` (the scene's ground truth) exactly the one box its mask gives? None: yes."""
+    scene_id = img["scene_id"]
+    expected = mask_box_xywh(mask, extent, img["width"], img["height"]) if mask.dtype == bool else None
+    if expected is None:
+        return f"scene {scene_id}: masks/{scene_id} is empty or not boolean"
+    if len(boxes) != 1:
+        return f"scene {scene_id}: {GROUNDTRUTH_FILE} has {len(boxes)} boxes for it, not 1"
+    if not np.allclose(boxes[0], expected, rtol=0.0, atol=1e-6):
+        return f"scene {scene_id}: its {GROUNDTRUTH_FILE} box {boxes[0]} is not the box of its mask {expected}"
+    return None
+
+
+def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha256: str,
+                         resolved: dict | None) -> list[str]:
+    """The ground truth against its recorded sha256. Where that is absent (collections
+    written before it, or an unusable resolved manifest) or differs, every scene is
+    checked against the plan and its box recomputed from its mask, so that each problem
+    names its scene."""
+    recorded = resolved.get("groundtruth_sha256") if resolved else None
+    if recorded is not None and recorded == groundtruth_sha256:
+        return []
+    arrays = resolved["arrays"] if resolved else {}
+    images = {img["scene_id"]: img for img in groundtruth["images"]}
+    boxes: dict[int, list] = {}
+    for ann in groundtruth["annotations"]:
+        boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
+    problems = []
+    if resolved:
+        grid = resolved["manifest"].get("reference_grid", {})
+        plan = {s.get("scene_id"): s for s in resolved.get("plan", []) if isinstance(s, dict)}
+        problems += [f"scene {s}: missing from {GROUNDTRUTH_FILE}" for s in plan if s not in images]
+        problems += [f"scene {s}: in {GROUNDTRUTH_FILE} but not in the plan" for s in images if s not in plan]
+        for scene_id, img in images.items():
+            planned = {**plan.get(scene_id, {}), "width": grid.get("width_px"), "height": grid.get("height_px")}
+            changed = [k for k in ("image_id", "environment_id", "distance_m", "width", "height")
+                       if scene_id in plan and img.get("id" if k == "image_id" else k) != planned.get(k)]
+            if changed:
+                problems.append(f"scene {scene_id}: {GROUNDTRUTH_FILE} differs from the plan in {', '.join(changed)}")
+    for scene_id, img in images.items():
+        path = f"masks/{scene_id}"
+        try:
+            data, attrs = read_checked(root, group, path, arrays.get(path), f"scene {scene_id}")
+            problem = _box_problem(img, boxes.get(img["id"], []), data, _extent(attrs, f"scene {scene_id}", path))
+        except (CollectionError, KeyError, TypeError) as exc:
+            problem = str(exc) if isinstance(exc, CollectionError) else f"scene {scene_id}: {GROUNDTRUTH_FILE} entry is malformed"
+        if problem:
+            problems.append(problem)
+    if recorded is not None and not problems:
+        problems.append(f"{GROUNDTRUTH_FILE} does not match its sha256 (edited or damaged)")
+    return problems
+
+
+def _load_resolved(root: Path) -> dict:
+    """The resolved manifest, parsed and checked against its own hashes."""
+    try:
+        resolved = yaml.safe_load((root / RESOLVED_MANIFEST_FILE).read_text())
+    except (OSError, yaml.YAMLError, UnicodeDecodeError) as exc:
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} is corrupted ({type(exc).__name__})") from None
+    if (not isinstance(resolved, dict) or not isinstance(resolved.get("manifest"), dict)
+            or not isinstance(resolved.get("arrays"), dict) or "manifest_sha256" not in resolved):
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} lacks 'manifest', 'manifest_sha256' or 'arrays'")
+    if canonical_sha256(resolved["manifest"]) != resolved["manifest_sha256"]:
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: its manifest does not match manifest_sha256 "
+                              "(edited or damaged)")
+    content = resolved.get("content_sha256")  # absent in collections written before it
+    if content is not None and content != resolved_content_sha256(resolved):
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} does not match its content_sha256 (edited or damaged)")
+    return resolved
+
+
+def _load_groundtruth(root: Path) -> tuple[dict, str]:
+    """The COCO ground truth and the sha256 of its file's bytes."""
+    try:
+        raw = (root / GROUNDTRUTH_FILE).read_bytes()
+        groundtruth = json.loads(raw)
+    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        raise CollectionError(f"{root}: {GROUNDTRUTH_FILE} is corrupted ({type(exc).__name__})") from None
+    try:
+        ok = (all({"scene_id", "id", "environment_id", "distance_m", "width", "height"} <= set(i)
+                  for i in groundtruth["images"])
+              and all({"image_id", "bbox"} <= set(a) for a in groundtruth["annotations"]))
+    except (KeyError, TypeError):
+        ok = False
+    if not ok:
+        raise CollectionError(f"{root}: {GROUNDTRUTH_FILE} is not a collection's COCO ground truth")
+    return groundtruth, hashlib.sha256(raw).hexdigest()
+
+
+def _progress_arrays(root: Path) -> dict[str, str]:
+    """The array hashes the progress records hold (what verify falls back on when the
+    resolved manifest is unusable)."""
+    arrays = {}
+    for record in sorted((root / PROGRESS_DIR).glob("*.json")):
+        try:
+            arrays.update(json.loads(record.read_text())["arrays"])
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+    return arrays
+
+
+def verify_collection(path: str | Path) -> list[str]:
+    """Check a whole collection; return every problem, one line each naming its scene
+    (plates: their environment): the resolved manifest (parses, manifest and content
+    hashes), every recorded array (sha256; masks too), and the ground truth (sha256, plan,
+    boxes recomputed from the masks). Empty: nothing is wrong."""
+    import zarr
+
+    from metricscenes.manifest import ManifestError, parse_manifest
+
+    root = Path(path)
+    if not root.is_dir():
+        return [f"{root}: no such collection folder"]
+    problems = []
+    resolved = groundtruth = None
+    try:
+        resolved = _load_resolved(root)
+        parse_manifest(resolved["manifest"], source=RESOLVED_MANIFEST_FILE)
+    except (CollectionError, ManifestError) as exc:
+        problems.append(str(exc).removeprefix(f"{root}: "))
+    try:
+        groundtruth = _load_groundtruth(root)
+    except CollectionError as exc:
+        problems.append(str(exc).removeprefix(f"{root}: "))
+    expected = resolved["arrays"] if resolved is not None else _progress_arrays(root)
+    if not expected:
+        problems.append("no recorded array hashes to check (manifest.resolved.yaml and progress/ are unusable)")
+    try:
+        group = zarr.open_group(str(root / RADIANCE_STORE), mode="r")
+    except Exception as exc:
+        return [*problems, f"{RADIANCE_STORE} is missing or unreadable ({type(exc).__name__})"]
+    for array_path, sha in sorted(expected.items()):
+        kind, _, rest = array_path.partition("/")
+        unit = rest.split("/")[0]
+        try:
+            read_checked(root, group, array_path, sha, f"environment {unit}" if kind == "plates" else f"scene {unit}")
+        except CollectionError as exc:
+            problems.append(str(exc))
+    if groundtruth is not None:  # without a usable resolved manifest, boxes are still checked against the masks
+        problems += groundtruth_problems(root, group, *groundtruth, resolved)
+    # A mask listed by its array hash and by the ground-truth check is one problem.
+    return list(dict.fromkeys(problems))

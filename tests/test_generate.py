@@ -27,8 +27,8 @@ def test_store_carries_names_units_and_wavelengths(smoke_collection):
 
     root = zarr.open_group(str(smoke_collection / "radiance.zarr"), mode="r")
     arrays = _resolved(smoke_collection)["arrays"]
-    assert {p.split("/")[0] for p in arrays} == {"plates", "insets", "frames"}
-    for path in arrays:
+    assert {p.split("/")[0] for p in arrays} == {"plates", "insets", "frames", "masks"}
+    for path in (p for p in arrays if not p.startswith("masks/")):
         arr = root[path]
         assert arr.metadata.dimension_names == ("y", "x", "wavelength")
         assert arr.attrs["units"] == "W sr-1 m-2 nm-1"
@@ -141,7 +141,7 @@ def test_verify_finds_a_corrupted_chunk(smoke_collection, tmp_path):
     data = bytearray(chunk.read_bytes())
     data[len(data) // 2] ^= 0xFF
     chunk.write_bytes(bytes(data))
-    assert path in Collection.open(out).verify()
+    assert any(path in problem for problem in Collection.open(out).verify())
 
 
 def test_conditions_are_linear_mixes_of_light_groups(smoke_collection):

@@ -8,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from benchmark.acceptance import paper_findings
+from benchmark.acceptance import night_findings, paper_findings
 
 DATA = Path(__file__).resolve().parents[1] / "docs" / "data"
 
@@ -27,12 +27,13 @@ def paper_parity():
     return _load("-640")
 
 
-@pytest.mark.parametrize("suffix", ["", "-640"], ids=["reference", "paper-parity"])
-def test_the_table_covers_13_cameras_day_and_night(suffix):
+@pytest.mark.parametrize("suffix, conditions", [("", {"day", "dusk", "night"}), ("-640", {"day", "night"})],
+                         ids=["reference", "paper-parity"])
+def test_the_table_covers_13_cameras_and_its_conditions(suffix, conditions):
     table, od50 = _load(suffix)
-    assert table["camera"].nunique() == 13 and set(table["condition"]) == {"day", "night"}
-    assert len(table) == 13 * 2 * 6 and (table["n_images"] == 10).all()
-    assert len(od50) == 26
+    assert table["camera"].nunique() == 13 and set(table["condition"]) == conditions
+    assert len(table) == 13 * len(conditions) * 6 and (table["n_images"] == 10).all()
+    assert len(od50) == 13 * len(conditions)
 
 
 def test_night_ap_is_below_day_ap_at_every_distance(tables):
@@ -64,3 +65,35 @@ def test_paper_parity_sweep_shows_all_three_findings(paper_parity):
     assert findings["ap_falls_with_distance"] and findings["ap_distance_rho_worst"] <= -0.8
     assert findings["night_below_day"]
     assert findings["od50_rises_with_mtf50"] and findings["od50_mtf50_rho"] >= 0.6
+
+
+# --- issue 10: night and dusk with the lamps of a real road (reference sweep) ---------------
+
+NIGHT_IS_BLIND = (
+    "With cited photometry (ego low beams to SAE J1383 / ECE R112, R7 tail lamps, IES road "
+    "luminaires) the car body ahead collects ~2 e- per pixel at 25 m (cam12, 16 ms, ISO 270) and "
+    "YOLOv5n finds no car under any acquisition policy; measured and explained in docs/results.md")
+
+
+def test_dusk_lies_between_night_and_day_at_25_m(tables):
+    findings = night_findings(*tables)
+    assert findings["dusk_between_at_near"], findings["dusk_between_cameras"]
+
+
+def test_night_is_below_day_at_every_distance(tables):
+    assert night_findings(*tables)["night_below_day_everywhere"]
+
+
+@pytest.mark.xfail(strict=True, reason=NIGHT_IS_BLIND)
+def test_night_ap_at_25_m_is_useful_for_every_camera(tables):
+    assert night_findings(*tables)["night_ap_near_useful"]
+
+
+@pytest.mark.xfail(strict=True, reason=NIGHT_IS_BLIND)
+def test_night_ap_falls_with_distance_for_every_camera(tables):
+    assert night_findings(*tables)["night_ap_falls_with_distance"]
+
+
+@pytest.mark.xfail(strict=True, reason=NIGHT_IS_BLIND)
+def test_night_od50_lies_inside_the_measured_range_for_ten_cameras(tables):
+    assert night_findings(*tables)["night_od50_inside"]

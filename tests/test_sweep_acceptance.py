@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark.acceptance import ap_distance_rho, paper_findings
+from benchmark.acceptance import ap_distance_rho, night_findings, paper_findings
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 MTF50 = {"cam01": 60.0, "cam02": 80.0, "cam03": 110.0, "cam04": 150.0}
@@ -84,3 +84,44 @@ def test_bad_input():
         paper_findings(table.drop(columns="ap"), od)
     with pytest.raises(ValueError, match="no 'night' rows"):
         paper_findings(table[table.condition == "day"], od)
+
+
+# --- issue 10: night and dusk criteria -----------------------------------------------------
+
+def night_tables(night_ap, dusk_factor=0.75):
+    """Day AP falls from 0.9; dusk is ``dusk_factor`` of day; night AP is ``night_ap(cam, d)``;
+    night OD50 is where the night AP crosses 0.5 (inside 25-200 m when it does)."""
+    rows, od = [], []
+    for cam, m in MTF50.items():
+        for d in DISTANCES:
+            day = 0.9 * np.exp(-d / 400)
+            for condition, ap in (("day", day), ("dusk", dusk_factor * day), ("night", night_ap(cam, d))):
+                rows.append({"camera": cam, "condition": condition, "distance_m": d, "ap": ap})
+        night = [night_ap(cam, d) for d in DISTANCES]
+        cross = next((d for d, a in zip(DISTANCES, night) if a < 0.5), 0.0) if night[0] >= 0.5 else 0.0
+        od.append({"camera": cam, "condition": "night", "mtf50_cy_per_mm": m, "od50_m": cross})
+    return pd.DataFrame(rows), pd.DataFrame(od)
+
+
+def test_night_findings_all_hold():
+    res = night_findings(*night_tables(lambda cam, d: 0.9 * np.exp(-d / 120), dusk_factor=0.9), near_m=25.0)
+    assert res["night_ap_near_useful"] and res["night_ap_near_min"] == pytest.approx(0.9 * np.exp(-25 / 120))
+    assert res["night_below_day_everywhere"] and res["night_ap_falls_with_distance"]
+    assert res["dusk_between_at_near"] and res["dusk_between_cameras"] == len(MTF50)
+    assert res["night_od50_inside_cameras"] == len(MTF50)  # 4 cameras: the >= 10 rule cannot hold
+    assert not res["night_od50_inside"]
+
+
+def test_night_findings_blind_night_fails_every_criterion():
+    res = night_findings(*night_tables(lambda cam, d: 0.0, dusk_factor=0.0))
+    assert not res["night_ap_near_useful"] and res["night_ap_near_min"] == 0.0
+    assert res["night_below_day_everywhere"]  # blind at night, not by day: below, trivially
+    assert not res["night_ap_falls_with_distance"] and np.isnan(res["night_rho_worst"])
+    assert res["night_od50_inside_cameras"] == 0
+    assert not res["dusk_between_at_near"]
+
+
+def test_night_findings_need_dusk_rows():
+    table, od = night_tables(lambda cam, d: 0.1)
+    with pytest.raises(ValueError, match="dusk"):
+        night_findings(table[table["condition"] != "dusk"], od)

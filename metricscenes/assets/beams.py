@@ -56,8 +56,12 @@ LOW_BEAM_HOT_SPOT_CD = 20_000.0
 """Typical of halogen and LED low beams (ECE R112 Class B: Imax <= 44 100 cd; J1383
 1.5D-2R >= 15 000 cd)."""
 LOW_BEAM_SPREAD_CD = 3_000.0
+"""Wide foreground light (J1383: >= 700-750 cd at 9-15° left and right, 1.5-2° down)."""
 GLARE_FLOOR_CD = 350.0
+"""Above the cut-off at H: the ECE B50L limit (350 cd) and J1383's sign-lighting minima."""
 HEADLAMP_LENS_CD = 120.0
+"""Axial intensity of a head lamp's Lambertian lens: the most that keeps lens + beam under
+J1383's 125 cd limit above 10U (see the module doc)."""
 HIGH_BEAM_PEAK_CD = 40_000.0
 """SAE J1383 high beam: H-V 20 000-75 000 cd."""
 
@@ -179,6 +183,8 @@ def check_test_points(intensity, points: tuple[TestPoint, ...], step_deg: float 
 # --- road luminaires ---------------------------------------------------------------
 
 LUMINAIRE_LENS_FRACTION = 0.1
+"""Share of the nadir intensity a road luminaire's diffusing cover carries (a modelling
+choice: lens + spot stay inside glare class G3, tested)."""
 ROAD_LUMINAIRE_PEAK_RATIO = 3.0
 """Peak over nadir intensity of the batwing (typical of IES Type II medium optics)."""
 
