@@ -7,6 +7,11 @@
 
 The ``hdr`` exposure policy captures a long and a short raw and merges them before the
 ISP (:mod:`benchmark.hdr`), then tone-maps before the sRGB encoding.
+
+Geometry: the camera sees its own field, 2·atan(width_px · pixel / 2f) ×
+2·atan(height_px · pixel / 2f), a window of the scene's field centred on the optical
+axis (:func:`camera_window`); a camera whose field exceeds the scene's is refused. The
+13 registry cameras see exactly the reference field, so their window *is* the field.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from benchmark import isp as _isp
 from benchmark import optics as _optics
 from benchmark import sensor as _sensor
 from benchmark.cameras.spec import CameraSpec
-from metricscenes.geometry import TanExtent
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, centred_extent, extent_within, fov_deg
 from metricscenes.radiance import SpectralScene
 
 
@@ -63,6 +68,33 @@ class Capture:
     merged_dn: np.ndarray | None = None
 
 
+class FieldOfViewError(ValueError):
+    """A camera sees more than the collection's field (one-line message naming both)."""
+
+
+def camera_extent(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> TanExtent:
+    """The camera's field in tangent coordinates, centred on the optical axis: ±half the
+    pixel array over the focal length. Edges within 10⁻⁶ (relative) of ``field``'s are
+    snapped onto them, so a camera of the reference geometry gets ``field`` itself. Not
+    checked against ``field`` (:func:`camera_window` is)."""
+    return centred_extent(camera.tan_half_width, camera.tan_half_height, field)
+
+
+def camera_window(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> TanExtent:
+    """The window of ``field`` (a collection's, or a scene's plate extent) that ``camera``
+    samples: :func:`camera_extent`, refused (:class:`FieldOfViewError`) where it exceeds
+    ``field`` in either axis. The registry cameras get ``field`` itself."""
+    window = camera_extent(camera, field)
+    if not extent_within(window, field):
+        h, v = camera.hfov_deg, camera.vfov_deg
+        fh, fv = fov_deg(field)
+        raise FieldOfViewError(
+            f"camera {camera.name!r} sees {h:.2f}° x {v:.2f}° (focal length {camera.optics.focal_length_mm:g} mm, "
+            f"pixel array {camera.sensor.array_width_mm:.4g} x {camera.sensor.array_height_mm:.4g} mm), more than "
+            f"the collection's field {fh:.2f}° x {fv:.2f}°: use a longer focal length or a smaller active area")
+    return window
+
+
 def electron_rate(
     scene: SpectralScene,
     camera: CameraSpec,
@@ -74,9 +106,12 @@ def electron_rate(
     """Noise-free signal, electrons·s⁻¹, per channel (3, rows, cols).
 
     ``shape_px`` (rows, cols) and ``extent`` select a window of the sensor (default:
-    the full frame); the window must be sampled at the camera's pixel pitch.
+    the full frame: the camera's own field, :func:`camera_window` of the scene's
+    field); the window must be sampled at the camera's pixel pitch.
     """
     rows, cols = shape_px or (camera.height_px, camera.width_px)
+    if extent is None:
+        extent = camera_window(camera, scene.extent)
     radiance = scene.resample(cols, rows, extent)
     if not np.all(np.isfinite(radiance)):
         raise ValueError("scene radiance contains NaN or infinite values")
@@ -90,7 +125,8 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
     """Simulate one capture of ``scene`` by ``camera``.
 
     Args:
-        scene: spectral radiance, W·sr⁻¹·m⁻²·nm⁻¹, covering the reference field of view.
+        scene: spectral radiance, W·sr⁻¹·m⁻²·nm⁻¹, over a field at least the camera's
+            (the camera samples its own window, :func:`camera_window`).
         camera: the camera spec.
         seed: temporal-noise seed (``np.random.default_rng(seed)``): same seed, same raw.
         noise: False switches every noise source off (shot, read, dark, PRNU, DSNU).

@@ -8,11 +8,11 @@ from typing import Annotated, Optional
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
 from benchmark.cli_cameras import app as cameras_app
 from benchmark import cli_detect, cli_leaderboard
+from metricscenes.cli import progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
@@ -63,14 +63,13 @@ def run(
         detector = load_detector(model, input_size=input_size, threads=threads)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
-    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), TimeRemainingColumn(), console=err) as bar:
-        task = bar.add_task(f"{cam.name} · {condition}", total=len(col.scenes()))
-        try:  # a damaged array is found when it is read: no results are written
+    try:  # a damaged array or a broken model is found on the way: nothing is written (run_camera stages)
+        with progress_bar(err) as bar:
+            task = bar.add_task(f"{cam.name} · {condition}", total=len(col.scenes()))
             results = run_camera(col, cam, condition, detector, out, seed=seed, save_images=save_images,
                                  backend=backend, progress=lambda done, total: bar.update(task, completed=done))
-        except (ValueError, CollectionError) as exc:
-            fail(str(exc).splitlines()[0])
+    except (ValueError, CollectionError, OSError) as exc:
+        fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
@@ -126,18 +125,17 @@ def sweep(
         fail(str(exc).splitlines()[0])
     if not cams or not conds:
         fail("--cameras and --conditions must each name at least one")
-    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), TimeRemainingColumn(), console=err) as bar:
-        task = bar.add_task("sweep", total=None)
+    try:
+        with progress_bar(err) as bar:
+            task = bar.add_task("sweep", total=None)
 
-        def progress(done: int, total: int, label: str) -> None:
-            bar.update(task, completed=done, total=total, description=label)
+            def progress(done: int, total: int, label: str) -> None:
+                bar.update(task, completed=done, total=total, description=label)
 
-        try:
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
                                progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy)
-        except (ValueError, DetectorError, CollectionError, OSError) as exc:
-            fail(str(exc).splitlines()[0])
+    except (ValueError, DetectorError, CollectionError, OSError) as exc:
+        fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     _, od50_table = sweep_module.load_sweep(out)
     title = f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments"
     if policy is not None:

@@ -66,11 +66,19 @@ def show_command(
     name: str = typer.Argument(..., help="cam01..cam13, a number, or a YAML path."),
     as_json: bool = typer.Option(False, "--json", help="Print JSON."),
 ) -> None:
-    """Show a camera's resolved spec (defaults filled in)."""
+    """Show a camera's resolved spec (defaults filled in) and what it implies: field of
+    view, IFOV, Nyquist, saturation, dynamic range, SNR at 100 lux, warnings."""
+    from benchmark.cameras.figures import camera_figures, camera_warnings, figure_rows
+
     cam = _load([name])[0]
+    try:
+        figures = camera_figures(cam)
+        warnings = camera_warnings(cam, figures)
+    except ValueError as exc:  # e.g. a QE file that cannot be read
+        _fail(f"{cam.name}: {str(exc).splitlines()[0]}")
     data = {**cam.model_dump(mode="json"), "sha256": cam.sha256()}
     if as_json:
-        print(json.dumps(data, indent=2))
+        print(json.dumps({**data, "derived": figures, "warnings": warnings}, indent=2))
         return
     table = Table(title=f"{cam.name}: {cam.label}")
     table.add_column("field")
@@ -82,6 +90,14 @@ def show_command(
         else:
             table.add_row(section, str(values))
     _out.print(table)
+    implied = Table(title="What the spec implies")
+    implied.add_column("figure")
+    implied.add_column("value")
+    for label, value in figure_rows(figures):
+        implied.add_row(label, value)
+    _out.print(implied)
+    for line in warnings:
+        _out.print(f"[bold yellow]warning:[/] {line}", highlight=False)
 
 
 @app.command("mtf")

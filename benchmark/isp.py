@@ -106,9 +106,16 @@ def checker_camera_rgb(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENG
     return (refl * d65) @ resp.T / (d65 @ resp.T)
 
 
+def _qe_sensor(qe_path: str) -> SensorSpec:
+    """A sensor that reads the QE file ``qe_path`` (the matrices depend on the spectral data only)."""
+    sensor = SensorSpec(pixel_um=1.0)
+    sensor._qe_path = qe_path
+    return sensor
+
+
 @functools.lru_cache(maxsize=32)
-def _color_matrix_cached(qe: str) -> np.ndarray:
-    sensor = SensorSpec(pixel_um=1.0, qe=qe)  # the matrix depends on the spectral data only
+def _color_matrix_cached(qe_path: str) -> np.ndarray:
+    sensor = _qe_sensor(qe_path)
     cam = checker_camera_rgb(sensor)
     target = checker_targets_linear_srgb()
     # Row sums fixed to 1: m3 = 1 − m1 − m2, so t − c3 = (c1 − c3) m1 + (c2 − c3) m2.
@@ -122,7 +129,7 @@ def _color_matrix_cached(qe: str) -> np.ndarray:
 
 def color_matrix(sensor: SensorSpec) -> np.ndarray:
     """3×3 matrix from white-balanced camera RGB to linear sRGB (rows sum to 1)."""
-    return _color_matrix_cached(sensor.qe).copy()
+    return _color_matrix_cached(str(sensor.qe_path.resolve())).copy()
 
 
 def checker_delta_e2000(sensor: SensorSpec) -> np.ndarray:
@@ -183,8 +190,8 @@ def tone_curve_reinhard(rgb_linear: np.ndarray, white: float) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=32)
-def _iset_mcc_matrix_cached(qe: str) -> np.ndarray:
-    sensor = SensorSpec(pixel_um=1.0, qe=qe)  # the matrix depends on the spectral data only
+def _iset_mcc_matrix_cached(qe_path: str) -> np.ndarray:
+    sensor = _qe_sensor(qe_path)
     _, refl = checker_reflectances()
     resp = channel_responsivity(sensor)
     d65 = illuminant_spectrum("D65")
@@ -205,7 +212,7 @@ def iset_mcc_matrix(sensor: SensorSpec) -> np.ndarray:
     RGB counts photo-electrons, so it pairs with ordinary XYZ as ISETCam's quanta
     responses pair with ``xyzQuanta``. Rows need not sum to anything: ISETCam fixes the
     scale at the end (:func:`iset_render`)."""
-    return _iset_mcc_matrix_cached(sensor.qe).copy()
+    return _iset_mcc_matrix_cached(str(sensor.qe_path.resolve())).copy()
 
 
 def iset_render(rgb_sensor: np.ndarray, sensor: SensorSpec) -> np.ndarray:

@@ -30,7 +30,7 @@ import numpy as np
 import scipy.optimize
 
 from benchmark import exposure, isp, optics, sensor
-from benchmark.camera import electron_rate
+from benchmark.camera import camera_extent, electron_rate
 from benchmark.cameras.spec import CameraSpec, SensorSpec
 from benchmark.targets import slanted_edge_scene
 from metricscenes.spectral import WAVELENGTHS_NM
@@ -271,7 +271,7 @@ def measure_mtf50(
         angle_deg = ISETCAM_EDGE_ANGLE_DEG if iset else 5.0
     d65 = isp.illuminant_spectrum("D65")
     scene, extent = slanted_edge_scene(
-        camera.width_px, camera.height_px, d65 * 1e-3, roi_px=roi_px, angle_deg=angle_deg
+        camera.width_px, camera.height_px, d65 * 1e-3, roi_px=roi_px, angle_deg=angle_deg, field=camera_extent(camera)
     )
     rate = sensor.mosaic(electron_rate(scene, camera, shape_px=roi_px, extent=extent), camera.sensor.cfa)
     policy = camera.exposure.model_copy(update={"mode": "auto_peak", "level": 0.9, "region_fraction": 1.0})

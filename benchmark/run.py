@@ -7,7 +7,8 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
 - ``results.json``: camera, condition, detector, collection, AP/AP50 per distance, OD50;
 - ``detections.json``: every detection (score ≥ 0.001) in COCO results format, boxes in
   the camera's pixels;
-- ``groundtruth.json``: the collection's ground truth scaled to the camera's grid;
+- ``groundtruth.json``: the collection's ground truth on the camera's grid (scaled, or
+  mapped onto the camera's window of the field: :func:`camera_geometry`);
 - ``images/<scene>.png``: the camera's sRGB images (optional).
 """
 
@@ -15,6 +16,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import shutil
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,17 +42,56 @@ def check_path_name(name: str, what: str) -> str:
 
 
 def check_out_dir(out_dir) -> Path:
-    """An output folder for benchmark: its own name follows :func:`check_path_name`, and
-    it is not a collection nor inside one (collections are read-only to benchmark)."""
+    """An output folder for benchmark: its own name follows :func:`check_path_name`, it is
+    not a file nor under one, and it is not a collection nor inside one (collections are
+    read-only to benchmark)."""
     from metricscenes.store import collection_containing
 
     out_dir = Path(out_dir)
     check_path_name(out_dir.name, "--out folder name")  # as typed: 'runs/..' and '.' name no folder
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"--out {out_dir} is a file, not a folder")
+    for parent in out_dir.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"--out {out_dir}: {parent} is a file, not a folder")
+            break
     inside = collection_containing(out_dir)
     if inside is not None:
         raise ValueError(f"--out {out_dir} is inside the collection {inside}: collections are read-only to "
                          "benchmark, choose a folder outside it")
     return out_dir
+
+
+def collection_field(collection):
+    """The field (tangent extent) a collection's plates and ground-truth grid cover: the
+    first scene's plate extent as stored, or the reference field for a collection
+    without scenes (or an object that cannot say)."""
+    from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+
+    scenes = collection.scenes()
+    sampling = getattr(collection, "angular_sampling", None)
+    if not scenes or sampling is None:
+        return REFERENCE_EXTENT
+    plate = next(layer for layer in sampling(scenes[0].scene_id) if layer["layer"] == "plate")
+    field = TanExtent(*(float(v) for v in plate["extent_tan"]))
+    return REFERENCE_EXTENT if field == REFERENCE_EXTENT else field
+
+
+def camera_geometry(collection, camera) -> dict | None:
+    """Where the camera sees less than the collection's field: its field and window, as
+    recorded in results.json (``camera_geometry``) and in the sweep cache key; None for a
+    camera that sees the whole field (the 13 registry cameras), whose results keep their
+    bytes. :class:`benchmark.camera.FieldOfViewError` for a camera that sees more."""
+    from benchmark.camera import camera_window
+    from metricscenes.geometry import fov_deg
+
+    field = collection_field(collection)
+    window = camera_window(camera, field)
+    if window == field:
+        return None
+    return {"hfov_deg": round(camera.hfov_deg, 6), "vfov_deg": round(camera.vfov_deg, 6),
+            "window_tan": list(window.as_tuple()), "collection_fov_deg": [round(v, 6) for v in fov_deg(field)]}
 
 
 @dataclass
@@ -76,17 +119,57 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
 
     ``progress`` is an optional callable ``(done, total)``. Returns the results dict
     (also written to ``out_dir/results.json``).
+
+    Everything is written to a staging folder inside ``out_dir`` first and moved into place
+    only when the run succeeded: a damaged scene or a broken model met halfway leaves
+    ``out_dir`` as it was (the folders the run created are removed).
     """
+    from benchmark.camera import camera_window
+
+    out_dir = check_out_dir(out_dir)  # before anything is written
+    camera_window(camera, collection_field(collection))  # a camera wider than the collection: refused here
+    created = [p for p in (out_dir, *out_dir.parents) if not p.exists()]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out_dir))
+    try:
+        results = _run_camera(collection, camera, condition, detector, out_dir, stage, seed=seed,
+                              save_images=save_images, backend=backend, progress=progress)
+        # Into place, one rename a file: images, detections and ground truth, then
+        # results.json last (a sweep takes a run folder with its results.json as finished).
+        if save_images:
+            (out_dir / "images").mkdir(exist_ok=True)
+            for image in sorted((stage / "images").iterdir()):
+                os.replace(image, out_dir / "images" / image.name)
+        for name in ("detections.json", "groundtruth.json", "results.json"):
+            os.replace(stage / name, out_dir / name)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        for folder in created:  # the folders this run made, innermost first, if still empty
+            try:
+                folder.rmdir()
+            except OSError:
+                break
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
+    return results
+
+
+def _run_camera(collection, camera, condition: str, detector, out_dir: Path, stage: Path, *, seed: int,
+                save_images: bool, backend: str, progress) -> dict:
+    """:func:`run_camera`'s work, writing into ``stage``."""
     from PIL import Image
 
-    from benchmark.camera import simulate
+    from benchmark.camera import camera_window, simulate
     from benchmark.detectors import coco_category_id
     from benchmark.scoring import ap_by_distance, od50
     from metricscenes import __version__
     from metricscenes.groundtruth import scale_groundtruth
 
     out_dir = check_out_dir(out_dir)  # before anything is written
-    (out_dir / "images" if save_images else out_dir).mkdir(parents=True, exist_ok=True)
+    field = collection_field(collection)
+    window = camera_window(camera, field)  # the window the camera samples (and its ground truth follows)
+    geometry = camera_geometry(collection, camera)
+    (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
     scenes = collection.scenes()
     timings = Timings()
     detections: list[dict] = []
@@ -115,12 +198,13 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
             })
         if save_images:
             t = time.perf_counter()
-            Image.fromarray(capture.rgb8).save(out_dir / "images" / f"{scene.scene_id}.png", compress_level=1)
+            Image.fromarray(capture.rgb8).save(stage / "images" / f"{scene.scene_id}.png", compress_level=1)
             timings.add("save_images", t)
         if progress:
             progress(i + 1, len(scenes))
 
-    groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px)
+    groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
+                                    field=field, window=window)
     t = time.perf_counter()
     per_distance = ap_by_distance(groundtruth, detections, backend=backend)
     timings.add("score", t)
@@ -148,11 +232,13 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
         "detections_sha256": sha256_bytes(detections_bytes),
         "timing_s": {k: round(v, 3) for k, v in timings.seconds.items()},
     }
+    if geometry is not None:  # a camera that sees a window of the field (the registry's keep their bytes)
+        results["camera_geometry"] = geometry
     if short_exposures:  # hdr only (other results keep their bytes); exposure_s holds the long frames
         results["exposure_short_s"] = short_exposures
-    (out_dir / "detections.json").write_bytes(detections_bytes)
-    (out_dir / "groundtruth.json").write_text(json.dumps(groundtruth))
-    (out_dir / "results.json").write_text(json.dumps(results, indent=1))
+    (stage / "detections.json").write_bytes(detections_bytes)
+    (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
+    (stage / "results.json").write_text(json.dumps(results, indent=1))
     return results
 
 

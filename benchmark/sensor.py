@@ -19,11 +19,9 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from benchmark.cameras.registry import DATA_DIR
 from benchmark.cameras.spec import SensorSpec
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j
 
@@ -60,10 +58,7 @@ def _read_qe_table(path: str) -> tuple[np.ndarray, np.ndarray]:
 
 def effective_qe(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
     """Colour-filter QE × IR-cut transmittance, (3, bands), interpolated to the bands."""
-    path = DATA_DIR / sensor.qe if (DATA_DIR / sensor.qe).is_file() else Path(sensor.qe)
-    if not path.is_file():
-        raise ValueError(f"sensor.qe: QE file {sensor.qe!r} not found (packaged name or path)")
-    wl, qe = _read_qe_table(str(path.resolve()))
+    wl, qe = _read_qe_table(str(sensor.qe_path.resolve()))
     return np.stack([np.interp(wavelengths_nm, wl, q, left=0.0, right=0.0) for q in qe])
 
 

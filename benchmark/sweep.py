@@ -64,17 +64,28 @@ def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) 
 
 
 def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
-    """What makes two runs interchangeable (the cache key)."""
-    return {"camera_spec_sha256": camera.sha256(), "condition": condition,
-            "model_sha256": detector.sha256, "input_size": str(detector.input_size),
-            "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
+    """What makes two runs interchangeable (the cache key). A camera that sees a window
+    of the collection's field adds its geometry (runs made before cameras had their own
+    field of view are redone); the registry cameras' keys are unchanged."""
+    from benchmark.run import camera_geometry
+
+    key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
+           "model_sha256": detector.sha256, "input_size": str(detector.input_size),
+           "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
+    geometry = camera_geometry(collection, camera)
+    if geometry is not None:
+        key["camera_geometry"] = geometry
+    return key
 
 
 def results_key(results: dict) -> dict:
     """The cache key recorded in a ``results.json``."""
-    return {"camera_spec_sha256": results["camera"]["spec_sha256"], "condition": results["condition"],
-            "model_sha256": results["detector"]["sha256"], "input_size": str(results["detector"]["input_size"]),
-            "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
+    key = {"camera_spec_sha256": results["camera"]["spec_sha256"], "condition": results["condition"],
+           "model_sha256": results["detector"]["sha256"], "input_size": str(results["detector"]["input_size"]),
+           "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
+    if "camera_geometry" in results:
+        key["camera_geometry"] = results["camera_geometry"]
+    return key
 
 
 def cached_results(run_dir: Path, key: dict) -> dict | None:
@@ -167,6 +178,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
     """
     from benchmark import run as run_module
+    from benchmark.camera import camera_window
     from benchmark.cameras import load_camera
     from benchmark.exposure import exposure_tag, format_exposure, with_exposure
     from metricscenes.store import Collection
@@ -190,7 +202,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     names = [c.name for c in cameras]
     if len(set(names)) != len(names):
         raise ValueError(f"camera names must be unique, got {names}")
-    for camera in cameras:  # every run folder name is valid before anything is written
+    field = run_module.collection_field(collection)
+    for camera in cameras:  # every run folder name and camera field is valid before anything is written
+        camera_window(camera, field)
         for condition in conditions:
             run_name(camera.name, condition, tags[camera.name])
     out_dir = run_module.check_out_dir(out_dir)

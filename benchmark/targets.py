@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from metricscenes.geometry import pixels_to_tan, TanExtent
+from metricscenes.geometry import REFERENCE_EXTENT, grid_to_tan, pixels_to_tan, TanExtent
 from metricscenes.radiance import RadianceLayer, SpectralScene
 
 
@@ -51,19 +51,25 @@ def slanted_edge_scene(
     angle_deg: float = 5.0,
     low: float = 0.1,
     high: float = 0.9,
+    field: TanExtent | None = None,
 ) -> tuple[SpectralScene, TanExtent]:
     """A slanted-edge target in the centre of a camera's field of view.
 
     The edge lives in an inset aligned with the camera's pixel grid (``width_px`` ×
-    ``height_px``) over the central ``roi_px`` (rows, cols) window; the plate around it
-    is uniform at the mean level. Radiance = ``spectrum`` (bands,) × reflectance.
+    ``height_px`` over ``field``, the camera's own field; default the reference field)
+    over the central ``roi_px`` (rows, cols) window; the plate around it is uniform at
+    the mean level. Radiance = ``spectrum`` (bands,) × reflectance.
 
     Returns:
         The scene and the window's extent (resample it at ``roi_px`` for the camera).
     """
     rows, cols = roi_px
     r0, c0 = (height_px - rows) // 2, (width_px - cols) // 2
-    corners = pixels_to_tan(np.array([[c0, r0], [c0 + cols, r0 + rows]], float), width_px, height_px)
+    px = np.array([[c0, r0], [c0 + cols, r0 + rows]], float)
+    if field is None or field == REFERENCE_EXTENT:
+        corners = pixels_to_tan(px, width_px, height_px)
+    else:
+        corners = grid_to_tan(px, field, width_px, height_px)
     extent = TanExtent(corners[0, 0], corners[0, 1], corners[1, 0], corners[1, 1])
     frac = square_coverage(edge_distance_px(roi_px, angle_deg), angle_deg)
     spectrum = np.asarray(spectrum, dtype=np.float32)

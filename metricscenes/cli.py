@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -25,6 +26,19 @@ def fail(message: str, code: int = 2) -> None:
     """One-line error, non-zero exit, no traceback."""
     err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
     raise typer.Exit(code)
+
+
+@contextmanager
+def progress_bar(console: Console, disable: bool = False):
+    """A rich progress bar that vanishes if the block fails, so an error stays one line."""
+    bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                   TimeElapsedColumn(), TimeRemainingColumn(), console=console, transient=False, disable=disable)
+    with bar:
+        try:
+            yield bar
+        except BaseException:
+            bar.live.transient = True
+            raise
 
 
 def _user_errors():
@@ -59,15 +73,15 @@ def generate(
             return
         if out is None:
             fail("--out is required unless --dry-run")
+        from metricscenes.generate import check_before_writing
         from metricscenes.generate import generate as run_generate
-        from metricscenes.render import check_variant
 
-        check_variant(m.render.variant)  # before any output: an LLVM variant can abort the process
+        # Before any output: --out, the memory estimate, the variant (LLVM can abort the
+        # process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
+        check_before_writing(m, out, workers)
 
         started = time.perf_counter()
-        with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      TimeElapsedColumn(), TimeRemainingColumn(), console=err, transient=False,
-                      disable=as_json) as bar:
+        with progress_bar(err, disable=as_json) as bar:
             task = bar.add_task(f"rendering {m.name}", total=None)
 
             def progress(done: int, total: int, key: str | None) -> None:
@@ -82,6 +96,9 @@ def generate(
             console.print(f"wrote {out} in {seconds:.1f} s")
     except _user_errors() as exc:
         fail(str(exc))
+    except OSError as exc:  # --out unwritable, disk full: one line, the lock released
+        where = f" ({exc.filename})" if exc.filename else ""
+        fail(f"cannot write {out}{where}: {exc.strerror or type(exc).__name__}")
 
 
 def _plan_table(scenes: list[dict]) -> None:

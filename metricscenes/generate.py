@@ -198,16 +198,62 @@ def _record_problem(root: Path, group, record: dict, manifest: Manifest) -> str 
     return None
 
 
+def check_out_dir(out_dir: str | Path) -> Path:
+    """Refuse (:class:`CollectionError`, one line) an ``--out`` that cannot hold this
+    collection, before anything is created: a file, a path through a file, a folder inside
+    another collection, or a folder that holds other files and is not a collection."""
+    from metricscenes.lock import LOCK_FILE
+    from metricscenes.store import collection_containing
+
+    root = Path(out_dir)
+    if root.exists() and not root.is_dir():
+        raise CollectionError(f"--out {root} is a file, not a folder; choose a folder for the collection")
+    for parent in root.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise CollectionError(f"--out {root}: {parent} is a file, not a folder")
+            break
+    inside = collection_containing(root)
+    if inside is not None and inside != Path(os.path.abspath(root)).resolve():
+        raise CollectionError(f"--out {root} is inside the collection {inside}; choose a folder outside it")
+    if inside is None and root.is_dir():
+        try:
+            # (a run killed before its stamp leaves at most its lock and an empty progress/)
+            other = sorted(p.name for p in root.iterdir() if p.name != LOCK_FILE
+                           and not (p.name == PROGRESS_DIR and p.is_dir() and not any(p.iterdir())))
+        except OSError as exc:
+            raise CollectionError(f"--out {root}: cannot list it ({exc.strerror})") from None
+        if other:
+            raise CollectionError(f"--out {root} holds other files ({', '.join(other[:3])}"
+                                  f"{', ...' if len(other) > 3 else ''}) and is not a collection; "
+                                  "choose a new or empty folder")
+    return root
+
+
+def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int = 1) -> Path:
+    """Everything that can refuse a run without rendering, before any output exists: the
+    ``--out`` folder, the memory the render needs, the Mitsuba variant."""
+    from metricscenes.manifest import check_memory
+    from metricscenes.render import check_variant
+
+    root = check_out_dir(out_dir)
+    check_memory(manifest, workers, source=f"manifest {manifest.name}")
+    check_variant(manifest.render.variant)  # an LLVM variant can abort the process, CUDA needs a GPU
+    return root
+
+
 def _prepare(root: Path, manifest: Manifest) -> None:
     import zarr
 
-    root.mkdir(parents=True, exist_ok=True)
     (root / PROGRESS_DIR).mkdir(exist_ok=True)
     stamp = root / PROGRESS_DIR / "manifest_sha256"
     if stamp.exists() and stamp.read_text().strip() != manifest.sha256():
-        raise CollectionError(
-            f"{root}: holds a collection of another manifest; choose another --out or delete it"
-        )
+        finished = any((root / PROGRESS_DIR).glob("*.json")) or (root / RESOLVED_MANIFEST_FILE).exists()
+        if finished:
+            raise CollectionError(
+                f"{root}: holds a collection of another manifest; choose another --out or delete it"
+            )
+        # a run of another manifest that finished no unit (a render error): nothing to keep
     write_atomic(stamp, manifest.sha256() + "\n")
     zroot = zarr.open_group(str(root / RADIANCE_STORE), mode="a")
     zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
@@ -224,11 +270,26 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
     ``workers`` processes render units in parallel; each uses ``threads`` render
     threads (default: the CPU count divided by the workers). ``progress`` is an
     optional callable ``(done, total, unit_key)``; ``notice`` an optional callable that
-    gets one line per finished unit found damaged (it is rendered again).
+    gets one line per finished unit found damaged (it is rendered again) and one when a
+    stale lock is taken over.
+
+    Before anything is created, :func:`check_before_writing` refuses a bad ``out_dir``, a
+    render that would not fit in memory and a Mitsuba variant that cannot run here; while
+    it writes, ``generate`` holds ``out_dir/generate.lock`` (:mod:`metricscenes.lock`), so a
+    second writer on the same folder is refused.
     """
+    from metricscenes.lock import collection_lock
+
+    root = check_before_writing(manifest, out_dir, workers)
+    root.mkdir(parents=True, exist_ok=True)
+    with collection_lock(root, notice=notice):  # one writer at a time; released on errors too
+        _generate(manifest, root, workers, threads, progress, notice)
+    return root
+
+
+def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None, progress, notice) -> None:
     import zarr
 
-    root = Path(out_dir)
     _prepare(root, manifest)
     scenes = plan_collection(manifest)
     units = plan_units(scenes)
@@ -264,7 +325,6 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
             for f in futures:
                 finish(f.result())
     _finalize(root, manifest, scenes, records)
-    return root
 
 
 def die_with_parent(parent_pid: int) -> None:

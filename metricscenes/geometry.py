@@ -1,11 +1,13 @@
 """Reference camera geometry shared by the scenes and every camera (DESIGN §3).
 
-All cameras have focal length 4.38 mm and an active area of 2.688 x 1.512 mm, so
-they see the same field of view; only the sampling (pixel pitch) and the optics
-(f-number) differ. Positions on the image plane are expressed as *tangent
-coordinates* (x, y) = (tan of the angle right of the optical axis, tan of the angle
-below it): a perspective image is uniformly sampled in them, so a pixel grid of any
-camera maps onto them by a scale alone.
+The collections are rendered over the reference field: focal length 4.38 mm over an
+active area of 2.688 x 1.512 mm (the paper's 13 cameras, which all see that field and
+differ only in sampling and f-number). Positions on the image plane are expressed as
+*tangent coordinates* (x, y) = (tan of the angle right of the optical axis, tan of the
+angle below it): a perspective image is uniformly sampled in them, so a pixel grid of
+any camera maps onto them by a scale and an offset. A camera with another focal length
+or active area samples its own window of the collection's field, centred on the
+optical axis (:func:`centred_extent`, ``benchmark.camera.camera_window``).
 """
 
 from __future__ import annotations
@@ -77,3 +79,43 @@ def pixels_to_tan(px_xy: np.ndarray, width_px: int, height_px: int) -> np.ndarra
     return np.stack(
         [e.x0 + p[..., 0] / width_px * e.width, e.y0 + p[..., 1] / height_px * e.height], axis=-1
     )
+
+
+def fov_deg(extent: TanExtent) -> tuple[float, float]:
+    """(horizontal, vertical) field of view of ``extent``, degrees."""
+    return (float(np.degrees(np.arctan(extent.x1) - np.arctan(extent.x0))),
+            float(np.degrees(np.arctan(extent.y1) - np.arctan(extent.y0))))
+
+
+def centred_extent(tan_half_width: float, tan_half_height: float, field: TanExtent,
+                   rtol: float = 1e-6) -> TanExtent:
+    """The window ±``tan_half_width`` × ±``tan_half_height`` around the optical axis, each
+    edge snapped onto ``field``'s where it is within ``rtol`` of the field's size (a
+    camera of the reference geometry gets exactly ``field``: same object, same floats).
+    Not checked against ``field``: see :func:`extent_within`."""
+    def snap(value: float, edge: float, size: float) -> float:
+        return edge if abs(value - edge) <= rtol * size else value
+
+    window = TanExtent(snap(-tan_half_width, field.x0, field.width), snap(-tan_half_height, field.y0, field.height),
+                       snap(tan_half_width, field.x1, field.width), snap(tan_half_height, field.y1, field.height))
+    return field if window == field else window
+
+
+def extent_within(window: TanExtent, field: TanExtent) -> bool:
+    """True if ``window`` lies inside ``field`` (edges may coincide)."""
+    return field.x0 <= window.x0 and window.x1 <= field.x1 and field.y0 <= window.y0 and window.y1 <= field.y1
+
+
+def tan_to_grid(tan_xy: np.ndarray, extent: TanExtent, width_px: int, height_px: int) -> np.ndarray:
+    """Tangent coordinates → continuous pixel coordinates of a ``width_px`` × ``height_px``
+    grid covering ``extent`` (pixel (0, 0)'s top-left corner is 0.0)."""
+    t = np.asarray(tan_xy, dtype=float)
+    return np.stack([(t[..., 0] - extent.x0) / extent.width * width_px,
+                     (t[..., 1] - extent.y0) / extent.height * height_px], axis=-1)
+
+
+def grid_to_tan(px_xy: np.ndarray, extent: TanExtent, width_px: int, height_px: int) -> np.ndarray:
+    """Inverse of :func:`tan_to_grid`."""
+    p = np.asarray(px_xy, dtype=float)
+    return np.stack([extent.x0 + p[..., 0] / width_px * extent.width,
+                     extent.y0 + p[..., 1] / height_px * extent.height], axis=-1)

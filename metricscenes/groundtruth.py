@@ -3,15 +3,17 @@
 The box is the tight box of the car's visible pixels in a rendered instance mask (at
 the inset's sampling, at least twice finer than the finest camera pixel for all but
 the nearest cars), cross-checked against the box of the car's projected mesh
-vertices. Boxes are floats in reference-grid pixels; a camera scales them to its own
-grid by its size ratio, as every camera covers the same field of view.
+vertices. Boxes are floats in reference-grid pixels. A camera that sees the whole
+field scales them to its own grid by its size ratio; one that sees a window of the
+field (another focal length or active area) maps them through tangent coordinates onto
+that window, exactly as its pixels sample the radiance (:func:`scale_groundtruth`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from metricscenes.geometry import tan_to_pixels, world_to_tan
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, grid_to_tan, tan_to_grid, tan_to_pixels, world_to_tan
 
 CAR_CATEGORY = {"id": 3, "name": "car", "supercategory": "vehicle"}
 
@@ -70,8 +72,20 @@ def coco_groundtruth(images: list[dict], boxes_xywh: list[list[float]], info: di
     return {"info": info, "images": images, "annotations": annotations, "categories": [CAR_CATEGORY]}
 
 
-def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int) -> dict:
-    """The same ground truth on another grid covering the same field of view (a camera's)."""
+def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int, *,
+                      field: TanExtent | None = None, window: TanExtent | None = None) -> dict:
+    """The same ground truth on a camera's ``width_px`` × ``height_px`` grid.
+
+    ``field``: the field the ground-truth grid covers (the collection's; default the
+    reference field); ``window``: the part of it the camera's grid covers (default the
+    whole field: the boxes are scaled by the size ratio, as ever). With a smaller window
+    each box goes through tangent coordinates onto the window (the mapping of
+    ``SpectralScene.resample(width_px, height_px, window)``), is clipped to the grid,
+    and is dropped where nothing of it is left in the camera's view.
+    """
+    field = REFERENCE_EXTENT if field is None else field
+    if window is not None and window != field:
+        return _groundtruth_in_window(groundtruth, width_px, height_px, field, window)
     out = {**groundtruth, "images": [], "annotations": []}
     scale = {}
     for image in groundtruth["images"]:
@@ -82,5 +96,24 @@ def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int) -> dict:
         sx, sy = scale[ann["image_id"]]
         x, y, w, h = ann["bbox"]
         box = [x * sx, y * sy, w * sx, h * sy]
+        out["annotations"].append({**ann, "bbox": box, "area": box[2] * box[3]})
+    return out
+
+
+def _groundtruth_in_window(groundtruth: dict, width_px: int, height_px: int, field: TanExtent,
+                           window: TanExtent) -> dict:
+    out = {**groundtruth, "images": [], "annotations": []}
+    grids = {}
+    for image in groundtruth["images"]:
+        grids[image["id"]] = (image["width"], image["height"])
+        out["images"].append({**image, "width": width_px, "height": height_px})
+    for ann in groundtruth["annotations"]:
+        w_ref, h_ref = grids[ann["image_id"]]
+        x, y, w, h = ann["bbox"]
+        tan = grid_to_tan(np.array([[x, y], [x + w, y + h]], float), field, w_ref, h_ref)
+        (x0, y0), (x1, y1) = np.clip(tan_to_grid(tan, window, width_px, height_px), 0.0, [width_px, height_px])
+        if x1 <= x0 or y1 <= y0:
+            continue  # the car lies outside the camera's field
+        box = [float(x0), float(y0), float(x1 - x0), float(y1 - y0)]
         out["annotations"].append({**ann, "bbox": box, "area": box[2] * box[3]})
     return out

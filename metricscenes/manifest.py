@@ -3,21 +3,50 @@
 A manifest is a small YAML file (see ``manifests/``). :func:`load_manifest` reads
 and validates it and raises :class:`ManifestError` with a one-line message naming the
 offending field, so the CLI can report it without a traceback.
+
+A manifest is validated as a whole before anything is written: UTF-8 YAML without
+duplicate keys, strict types (``environments: true`` or ``seed: "5"`` are refused, not
+coerced), finite numbers, lists without repeats, condition names that can name a folder
+and do not use the ``<base>@<level>lux`` form reserved for the illuminance sweep, and
+(:func:`check_memory`, at ``generate``) a render that fits in memory.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
+import re
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator, model_validator
 
 LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "car_lights", "street_lights", "ego_lights", "ego_high_beam")
 PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights", "ego_lights", "ego_high_beam")
 """Groups that can light the background; car lamps only matter where the car is (the inset)."""
+
+
+MAX_WEIGHT = 1e6
+"""Largest light-group weight of a condition (a weight of 1e300 would overflow float32 radiance)."""
+MAX_MANIFEST_BYTES = 1 << 20
+CONDITION_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+"""A condition name becomes a folder name (``benchmark sweep``): no ``/``, no ``@`` (the
+illuminance sweep's ``<base>@<level>lux`` names are reserved), no leading dot, no ``..``."""
+
+# What one render process needs: the interpreter, Mitsuba and the scene (~0.35 GiB,
+# measured), plus ~500 bytes per pixel of the largest film (31 float32 bands held about
+# four times: Mitsuba's image block, the developed film, the NumPy copy, the zarr write;
+# measured 580 B/px at 1920x1080, 500 B/px between 960x540 and 1920x1080).
+PROCESS_BASE_BYTES = 400 * 2**20
+BYTES_PER_FILM_PIXEL = 512
+MEMORY_LIMIT_ENV = "METRICSCENES_MAX_MEMORY_GIB"
+
+# Numbers: ints must be ints (not bools, floats or strings), floats may be ints but not
+# bools or strings, and no NaN or infinity anywhere (model_config allow_inf_nan=False).
+Int = Annotated[int, Strict()]
+Float = Annotated[float, Strict()]
 
 
 class ManifestError(ValueError):
@@ -25,14 +54,23 @@ class ManifestError(ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+def _unique(values, what: str):
+    from collections import Counter
+
+    repeated = sorted(repr(v) for v, n in Counter(values).items() if n > 1)
+    if repeated:
+        raise ValueError(f"{what} must not repeat: {', '.join(repeated)}")
+    return values
 
 
 class ReferenceGrid(_Strict):
     """Pixel grid of the plates and of the ground-truth boxes (covers the cameras' field of view)."""
 
-    width_px: int = Field(ge=16, le=8192)
-    height_px: int = Field(ge=9, le=4608)
+    width_px: Int = Field(ge=16, le=8192)
+    height_px: Int = Field(ge=9, le=4608)
 
     @model_validator(mode="after")
     def _aspect(self) -> "ReferenceGrid":
@@ -42,13 +80,13 @@ class ReferenceGrid(_Strict):
 
 
 class RenderSettings(_Strict):
-    plate_spp: int = Field(ge=1, le=65536, description="samples per pixel of plates")
-    inset_spp: int = Field(ge=1, le=65536, description="samples per pixel of insets")
-    inset_pixel_mrad: float = Field(
+    plate_spp: Int = Field(ge=1, le=65536, description="samples per pixel of plates")
+    inset_spp: Int = Field(ge=1, le=65536, description="samples per pixel of insets")
+    inset_pixel_mrad: Float = Field(
         0.114, gt=0.0, le=10.0, description="target angular sampling of insets, mrad per pixel"
     )
-    inset_max_px: int = Field(512, ge=32, le=8192, description="cap on an inset's longer side, pixels")
-    max_depth: int = Field(6, ge=2, le=64, description="path length limit of the path tracer")
+    inset_max_px: Int = Field(512, ge=32, le=8192, description="cap on an inset's longer side, pixels")
+    max_depth: Int = Field(6, ge=2, le=64, description="path length limit of the path tracer")
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral"] = "scalar_spectral"
 
 
@@ -60,7 +98,7 @@ class IlluminanceSweep(_Strict):
 
     base: str
     ambient_group: Literal[PLATE_LIGHT_GROUPS]  # type: ignore[valid-type]
-    levels_lux: tuple[float, ...] = Field(min_length=1)
+    levels_lux: tuple[Float, ...] = Field(min_length=1)
     lamps_on: tuple[Literal[LIGHT_GROUPS], ...] = ()  # type: ignore[valid-type]
 
     @field_validator("levels_lux")
@@ -68,23 +106,47 @@ class IlluminanceSweep(_Strict):
     def _positive(cls, v: tuple[float, ...]) -> tuple[float, ...]:
         if any(not (0 < lux < 2e5) for lux in v):
             raise ValueError("every level must lie in (0, 200000) lux")
+        # Each level names a condition '<base>@<level:g>lux': 1 and 1.0000001 would be one name.
+        _unique([f"{lux:g}" for lux in v], "levels (as condition names)")
         return v
+
+    @field_validator("lamps_on")
+    @classmethod
+    def _lamps_unique(cls, v: tuple[str, ...]) -> tuple[str, ...]:
+        return _unique(v, "light groups")
 
 
 class Manifest(_Strict):
-    """A collection definition (see docs/collections.md)."""
+    """A collection definition (see docs/scenes.md, "The protocol")."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
     protocol: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
     description: str = ""
-    seed: int = Field(ge=0, le=2**63 - 1)
-    environments: int = Field(ge=1, le=10000)
-    distances_m: tuple[float, ...] = Field(min_length=1)
+    seed: Int = Field(ge=0, le=2**63 - 1)
+    environments: Int = Field(ge=1, le=10000)
+    distances_m: tuple[Float, ...] = Field(min_length=1)
     reference_grid: ReferenceGrid
     render: RenderSettings
     light_groups: tuple[Literal[LIGHT_GROUPS], ...] = Field(min_length=1)  # type: ignore[valid-type]
-    conditions: dict[str, dict[str, float]] = Field(min_length=1)
+    conditions: dict[str, dict[str, Float]] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
+
+    @field_validator("light_groups")
+    @classmethod
+    def _groups_unique(cls, v: tuple[str, ...]) -> tuple[str, ...]:
+        return _unique(v, "light groups")
+
+    @field_validator("conditions")
+    @classmethod
+    def _condition_names(cls, v: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
+        for name in v:
+            if "@" in name:
+                raise ValueError(f"condition name {name!r}: '@' is reserved for the illuminance sweep's "
+                                 "conditions (<base>@<level>lux)")
+            if not CONDITION_NAME.fullmatch(name) or ".." in name or len(name) > 64:
+                raise ValueError(f"condition name {name!r} must be 1-64 letters, digits, '_', '-' or '.' "
+                                 "(not first), without '..'")
+        return v
 
     @field_validator("distances_m")
     @classmethod
@@ -104,8 +166,10 @@ class Manifest(_Strict):
                         f"conditions.{name}.{group}: light group is not rendered "
                         f"(light_groups: {', '.join(self.light_groups)})"
                     )
-                if not (w >= 0.0):
-                    raise ValueError(f"conditions.{name}.{group}: weight must be >= 0, got {w}")
+                if not (0.0 <= w <= MAX_WEIGHT):
+                    raise ValueError(f"conditions.{name}.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
+            if not any(weights.values()):
+                raise ValueError(f"conditions.{name}: lights nothing (give at least one light group a weight > 0)")
         sweep = self.illuminance_sweep
         if sweep is not None:
             if sweep.base not in self.conditions:
@@ -121,6 +185,61 @@ class Manifest(_Strict):
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
         return canonical_sha256(self.model_dump(mode="json"))
+
+    def largest_film_px(self) -> int:
+        """Upper bound on the pixels of the largest film a unit renders: a plate (or a
+        car-lamp frame) on the reference grid, or an inset: a crop of the reference film
+        k times finer (k at most what ``inset_pixel_mrad`` asks for) whose longer side is
+        at most ``inset_max_px`` (plus rounding), unless k = 1 (see ``generate.inset_window``)."""
+        import math
+
+        from metricscenes.geometry import REFERENCE_EXTENT
+
+        w, h = self.reference_grid.width_px, self.reference_grid.height_px
+        k_fine = math.ceil(1e3 * REFERENCE_EXTENT.width / w / self.render.inset_pixel_mrad)
+        inset = min((self.render.inset_max_px + 2) ** 2, w * h * k_fine**2)
+        return max(w * h, inset)
+
+    def memory_estimate_bytes(self) -> int:
+        """Upper estimate of one render process's peak memory (see PROCESS_BASE_BYTES)."""
+        return PROCESS_BASE_BYTES + BYTES_PER_FILM_PIXEL * self.largest_film_px()
+
+
+def memory_limit_bytes() -> tuple[int, str]:
+    """(limit, where it comes from): ``METRICSCENES_MAX_MEMORY_GIB`` if set, else 80 % of
+    this machine's physical memory."""
+    value = os.environ.get(MEMORY_LIMIT_ENV)
+    if value is not None:
+        try:
+            gib = float(value)
+        except ValueError:
+            gib = float("nan")
+        if not (0 < gib < 2**40):
+            raise ManifestError(f"{MEMORY_LIMIT_ENV}={value!r}: must be a positive number of GiB")
+        return int(gib * 2**30), f"set by {MEMORY_LIMIT_ENV}"
+    try:
+        return int(0.8 * os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")), "80 % of this machine's memory"
+    except (ValueError, OSError, AttributeError):  # not POSIX: no limit known
+        return 2**62, "no known limit"
+
+
+def check_memory(manifest: Manifest, workers: int = 1, source: str = "manifest") -> int:
+    """Refuse (:class:`ManifestError`, one line saying how much) a render that would need
+    more memory than :func:`memory_limit_bytes`; return the estimate in bytes."""
+    per_process = manifest.memory_estimate_bytes()
+    need = per_process * max(1, workers)
+    limit, where = memory_limit_bytes()
+    if need > limit:
+        gib = 2**30
+        grid = manifest.reference_grid
+        each = f"{workers} workers x {per_process / gib:.1f} GiB" if workers > 1 else "one process"
+        raise ManifestError(
+            f"{source}: rendering would need about {need / gib:.1f} GiB ({each}: films up to "
+            f"{manifest.largest_film_px() / 1e6:.1f} Mpx x 31 bands, plates {grid.width_px}x{grid.height_px}, "
+            f"insets up to {manifest.render.inset_max_px} px), above the limit of {limit / gib:.1f} GiB "
+            f"({where}{'' if MEMORY_LIMIT_ENV in where else f'; set {MEMORY_LIMIT_ENV} to change it'}); "
+            "use a smaller reference_grid, render.inset_max_px or --workers")
+    return need
 
 
 def canonical_sha256(data) -> str:
@@ -138,23 +257,62 @@ def parse_manifest(data: object, source: str = "manifest") -> Manifest:
         return Manifest.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
-        where = ".".join(str(p) for p in err["loc"])
+        # a key with a newline or a NUL must not break the one-line message
+        where = ".".join(str(p) if str(p).isprintable() else repr(p) for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
         # Cross-field checks already name their fields in the message.
-        raise ManifestError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}") from None
+        message = f"{source}: {where}: {msg}" if where else f"{source}: {msg}"
+        raise ManifestError(" ".join(message.splitlines())) from None
+    except RecursionError:
+        raise ManifestError(f"{source}: nested too deeply") from None
+
+
+class DuplicateKeyError(yaml.constructor.ConstructorError):
+    """A YAML mapping names the same key twice (PyYAML would keep the last silently)."""
+
+
+class UniqueKeyLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses duplicate keys in a mapping."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue  # '<<' merges are PyYAML's business (and may override)
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    duplicate = key in seen
+                    seen.add(key)
+                except TypeError:
+                    continue  # an unhashable key: the base class reports it
+                if duplicate:
+                    raise DuplicateKeyError(None, None, f"duplicate key {key!r}", key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
 
 
 def load_manifest(path: str | Path) -> Manifest:
-    """Read and validate a manifest YAML file."""
+    """Read and validate a manifest YAML file (UTF-8, at most 1 MiB, no duplicate keys)."""
     path = Path(path)
     try:
-        text = path.read_text()
+        with open(path, "rb") as f:
+            raw = f.read(MAX_MANIFEST_BYTES + 1)
     except OSError as exc:
-        raise ManifestError(f"{path}: cannot read manifest ({exc.strerror})") from None
+        raise ManifestError(f"{path}: cannot read manifest ({exc.strerror or type(exc).__name__})") from None
+    if len(raw) > MAX_MANIFEST_BYTES:
+        raise ManifestError(f"{path}: larger than {MAX_MANIFEST_BYTES // 2**20} MiB: not a manifest")
     try:
-        data = yaml.safe_load(text)
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ManifestError(f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start})") from None
+    try:
+        data = yaml.load(text, Loader=UniqueKeyLoader)
+    except DuplicateKeyError as exc:
+        raise ManifestError(f"{path}: {exc.problem} at line {exc.problem_mark.line + 1}") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark else ""
         raise ManifestError(f"{path}: not valid YAML{where}") from None
+    except RecursionError:
+        raise ManifestError(f"{path}: not valid YAML (nested too deeply)") from None
     return parse_manifest(data, source=str(path))

@@ -55,24 +55,35 @@ def check_variant(variant: str) -> None:
 
     if variant not in mi.variants():
         raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
-    if variant.startswith("llvm"):
-        _probe_llvm(variant)
+    if variant.startswith(("llvm", "cuda")):
+        _probe_jit(variant)
 
 
 @lru_cache(maxsize=None)
-def _probe_llvm(variant: str) -> None:
-    """Render 2x2 pixels with an LLVM variant in a child process first: with a libLLVM
-    older than 17 (Debian 12's default is 15) the first render aborts the whole process
-    (``LLVM ERROR: Cannot select ... fminimum``), which no exception can catch."""
+def _probe_jit(variant: str) -> None:
+    """Render 2x2 pixels with an LLVM or CUDA variant in a child process first. With a
+    libLLVM older than 17 (Debian 12's default is 15) the first LLVM render aborts the
+    whole process (``LLVM ERROR: Cannot select ... fminimum``), which no exception can
+    catch; a CUDA variant is listed on machines without a GPU and fails only when used."""
     import subprocess
     import sys
 
-    probe = subprocess.run([sys.executable, "-c", _LLVM_PROBE.format(variant=variant)],
-                           capture_output=True, text=True, timeout=300)
-    if probe.returncode != 0:
+    try:
+        probe = subprocess.run([sys.executable, "-c", _LLVM_PROBE.format(variant=variant)],
+                               capture_output=True, text=True, timeout=300)
+    except subprocess.TimeoutExpired:
+        raise RenderError(f"Mitsuba variant {variant!r} did not render 2x2 pixels in 300 s; "
+                          "use render.variant: scalar_spectral") from None
+    if probe.returncode == 0:
+        return
+    if variant.startswith("llvm"):
         raise RenderError(
             f"Mitsuba variant {variant!r} crashes here (libLLVM < 17?); install libllvm19 "
             f"or use render.variant: scalar_spectral")
+    lines = [line.strip() for line in probe.stderr.splitlines() if line.strip()]
+    why = lines[-1][:160] if lines else f"exit status {probe.returncode}"
+    raise RenderError(f"Mitsuba variant {variant!r} cannot run here (no usable CUDA GPU: {why}); "
+                      "use render.variant: scalar_spectral")
 
 
 @dataclass(frozen=True)

@@ -277,7 +277,11 @@ class Collection:
         import zarr
 
         if self._zarr is None:
-            self._zarr = zarr.open_group(str(self.root / RADIANCE_STORE), mode="r")
+            try:
+                self._zarr = zarr.open_group(str(self.root / RADIANCE_STORE), mode="r")
+            except Exception as exc:  # its zarr.json is missing or damaged
+                raise CollectionError(f"{self.root}: {RADIANCE_STORE} is missing or unreadable ({type(exc).__name__}); "
+                                      f"{REPAIR_HINT}") from None
         return self._zarr
 
     @property

@@ -1,4 +1,7 @@
-"""Shared by the leaderboard tests: a leaderboard's accepted-protocol file and the CLI app."""
+"""Shared by the leaderboard tests: a leaderboard's accepted-protocol file and the CLI app.
+
+PROTOCOLS accepts the smoke manifest with the 4 environments of the synthetic runs
+(:func:`benchmark.leaderboard.synthetic.write_synthetic_run`), not the collection's 2."""
 
 from __future__ import annotations
 
@@ -13,6 +16,7 @@ PROTOCOLS = """protocols:
     distances_m: [25, 50, 75, 100, 150, 200]
     conditions: [day, night]
     required_conditions: [day]
+    n_environments: 4
 """
 
 

@@ -62,3 +62,73 @@ def test_bad_yaml_gives_one_line_value_error(tmp_path, text, pattern):
     with pytest.raises(ValueError, match=pattern) as info:
         load_camera(path)
     assert "\n" not in str(info.value)
+
+
+# --- specs validated as a whole (issue 13.7) ----------------------------------------------
+
+_BASE = "name: x\noptics: {f_number: 2}\n"
+
+
+@pytest.mark.parametrize(
+    "sensor, pattern",
+    [
+        ("{pixel_um: 1, adc_bits: 8, black_level_dn: 4096}", r"black_level_dn 4096 must be below the ADC white level 255"),
+        ("{pixel_um: 1, adc_bits: 8, black_level_dn: 255}", r"black_level_dn 255 must be below the ADC white level 255"),
+        ("{pixel_um: 1, qe: /etc/passwd}", r"sensor\.qe' = '/etc/passwd': an absolute path is refused"),
+        ("{pixel_um: 1, qe: ../x.csv}", r"sensor\.qe' = '\.\./x\.csv': '\.\.' is refused"),
+        ("{pixel_um: 1, qe: data/../../x.csv}", r"'\.\.' is refused"),
+        ("{pixel_um: 1, qe: 'C:\\x.csv'}", r"sensor\.qe.*a relative path with '/' separators is expected"),
+        ("{pixel_um: 1, qe: missing.csv}", r"qe 'missing\.csv': no packaged file of that name and no file .*missing\.csv"),
+        ("{pixel_um: 1, qe: notes.txt}", r"a \.csv file is expected"),
+        ("{pixel_um: 0.2}", r"13440 x 7560 px \(101\.6 Mpx.*about 24\.2 GiB, above the 4 GiB limit"),
+        ("{pixel_um: 0.2, active_width_mm: 50, active_height_mm: 50}", r"250000 x 250000 px.*GiB, above the 4 GiB"),
+        ("{pixel_um: 1.4, active_width_mm: 50, active_height_mm: 50}", r"35714 x 35714 px.*about 304\.1 GiB"),
+        ("{pixel_um: 10, active_width_mm: 0.1}", r"10 x 151 px .*at least 16 px per side"),
+    ],
+)
+def test_bad_sensor_as_a_whole_is_refused_in_one_line(tmp_path, sensor, pattern):
+    path = tmp_path / "bad.yaml"
+    path.write_text(_BASE + f"sensor: {sensor}\n")
+    with pytest.raises(ValueError, match=pattern) as info:
+        load_camera(path)
+    assert "\n" not in str(info.value) and str(path) in str(info.value)
+
+
+def test_unknown_illuminant_is_refused_and_known_ones_pass(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(_BASE + "sensor: {pixel_um: 1}\nisp: {white_balance: known_illuminant, illuminant: D66}\n")
+    with pytest.raises(ValueError, match=r"isp\.illuminant' = 'D66': unknown illuminant 'D66'") as info:
+        load_camera(path)
+    assert "\n" not in str(info.value)
+    path.write_text(_BASE + "sensor: {pixel_um: 1}\nisp: {white_balance: known_illuminant, illuminant: A}\n")
+    assert load_camera(path).isp.illuminant == "A"
+
+
+def test_qe_user_file_is_read_beside_the_spec_file(tmp_path, monkeypatch):
+    import numpy as np
+
+    from benchmark.cameras import DATA_DIR
+    from benchmark.isp import color_matrix
+    from benchmark.sensor import effective_qe
+
+    folder = tmp_path / "mycam"
+    (folder / "data").mkdir(parents=True)
+    lines = (DATA_DIR / "imx363_qe.csv").read_text().splitlines()
+    halved = [lines[0]] + [",".join([row.split(",")[0]] + [f"{float(v) / 2:.6g}" for v in row.split(",")[1:4]]
+                                    + row.split(",")[4:]) for row in lines[1:]]
+    (folder / "data" / "half_qe.csv").write_text("\n".join(halved) + "\n")
+    (folder / "cam.yaml").write_text(_BASE + "sensor: {pixel_um: 1.4, qe: data/half_qe.csv}\n")
+    monkeypatch.chdir(tmp_path)  # not the spec's folder: the file is found beside the spec anyway
+    cam = load_camera("mycam/cam.yaml")
+    assert cam.sensor.qe == "data/half_qe.csv"  # the spec (and its sha256) keep the relative name
+    assert cam.sensor.qe_path == (folder / "data" / "half_qe.csv").resolve()
+    reference = load_camera("cam10").sensor
+    np.testing.assert_allclose(effective_qe(cam.sensor), effective_qe(reference) / 2, rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(color_matrix(cam.sensor), color_matrix(reference), atol=1e-4)  # scale-free fit
+    assert load_camera(folder / "cam.yaml") == cam
+
+
+def test_registry_specs_pass_the_whole_spec_checks_unchanged():
+    for cam in list_cameras():
+        assert cam.sensor.qe == "imx363_qe.csv" and cam.sensor._qe_path is None
+        assert cam.sensor.capture_memory_bytes < 1.0 * 2**30

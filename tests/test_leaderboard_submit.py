@@ -79,6 +79,7 @@ def test_packaged_protocols_accept_the_packaged_manifests():
         assert m.protocol == name
         assert m.sha256() in protocol.manifests_sha256, f"{name}: manifest sha256 is now {m.sha256()}"
         assert protocol.distances_m == tuple(m.distances_m)
+        assert protocol.n_environments == m.environments
         assert set(protocol.conditions) <= set(m.conditions) and "day" in protocol.required_conditions
 
 
@@ -151,12 +152,13 @@ def test_sweep_bootstrap_cache_is_used(tmp_path, sweep, leaderboard):
     run = tmp_path / "run"
     shutil.copytree(sweep / "runs" / "cam07-day", run)
     sha = json.loads((run / "results.json").read_text())["detections_sha256"]
+    # a stored interval must hold the run's OD50 (68.3 m here), or validation refuses it
     cache = {"key": {"detections_sha256": sha, "n_resamples": 20, "seed": 0},
-             "od50": {"od50_m": 80.0, "sd_m": 12.345, "ci95_m": [70.0, "inf"], "n_resamples": 20}}  # fmt: skip
+             "od50": {"od50_m": 80.0, "sd_m": 12.345, "ci95_m": [50.0, "inf"], "n_resamples": 20}}  # fmt: skip
     (run / "od50.json").write_text(json.dumps(cache))
     protocols = load_protocols(leaderboard)
     day = build_submission(find_runs(run), name="c", submitter="s", n_resamples=20, measure_mtf=False, protocols=protocols)["conditions"]["day"]
-    assert day["od50_sd_m"] == 12.345 and day["od50_ci95_m"] == [70.0, None]
+    assert day["od50_sd_m"] == 12.345 and day["od50_ci95_m"] == [50.0, None]
     day = build_submission(find_runs(run), name="c", submitter="s", n_resamples=21, measure_mtf=False, protocols=protocols)["conditions"]["day"]
     assert day["od50_sd_m"] != 12.345  # other settings: recomputed
 

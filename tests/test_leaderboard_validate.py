@@ -7,6 +7,7 @@ import copy
 import hashlib
 import json
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -138,6 +139,35 @@ def _od50_off(sub):
     cond["od50_m"] = 12.0 if cond["od50_m"] != 12.0 else 13.0
 
 
+def _ap_above_ap50(sub):
+    row = sub["conditions"]["day"]["per_distance"][0]  # 25 m: AP well above 0.05
+    assert row["ap"] > 0.05
+    row["ap50"] = round(row["ap"] - 0.05, 6)
+
+
+def _day_od50(sub) -> float:
+    value = sub["conditions"]["day"]["od50_m"]
+    assert value is not None  # the synthetic day curve crosses 0.5 within the distances
+    return value
+
+
+def _ci_reversed(sub):
+    od = _day_od50(sub)
+    sub["conditions"]["day"]["od50_ci95_m"] = [od + 5.0, od - 5.0]
+
+
+def _ci_lo_infinite(sub):
+    sub["conditions"]["day"]["od50_ci95_m"] = [None, _day_od50(sub) + 5.0]
+
+
+def _same_detections(sub):
+    sub["conditions"]["night"]["detections_sha256"] = sub["conditions"]["day"]["detections_sha256"]
+
+
+def _sub_number(pattern: str, replacement: str):
+    return _text(lambda t: re.sub(pattern, replacement, t, count=1))
+
+
 # (id, make bytes from the good submission, file name, expected piece of the message)
 BAD = [
     ("not-json", lambda good: b"{this is not json", "good.json", "invalid JSON at line 1"),
@@ -177,6 +207,30 @@ BAD = [
     ("not-dot-json", lambda good: dumps_submission(good).encode(), "good.txt", "must end in .json"),
     ("over-5-MB", lambda good: dumps_submission(good).encode() + b" " * (5 * 1024 * 1024), "good.json", "over the 5 MB limit"),
     ("duplicate-name", _edit(lambda s: s.update(name="existing")), "existing.json", "duplicate name"),
+    # issue 13, point 5: what used to pass --check (or break `benchmark leaderboard` later)
+    ("name-trailing-newline", _edit(lambda s: s.update(name="good\n")), "good.json", "good.json: name: string holds a control character or line break U+000A"),
+    ("submitter-carriage-return", _edit(lambda s: s.update(submitter="b\r")), "good.json", "submitter: string holds a control character or line break U+000D"),
+    ("sha-trailing-newline", _edit(lambda s: s["detector"].update(sha256=s["detector"]["sha256"] + "\n")), "good.json",
+     "detector.sha256: string holds a control character or line break U+000A"),
+    ("overflow-to-infinity", _sub_number(r'"od50_sd_m": [0-9.]+', '"od50_sd_m": 1e400'), "good.json",
+     "good.json: invalid JSON: number 1e400 overflows to infinity"),
+    ("negative-overflow", _sub_number(r'"distance_m": 25(\.0)?', '"distance_m": -1E+999'), "good.json", "number -1E+999 overflows to infinity"),
+    ("integer-too-large", _sub_number(r'"n_images": [0-9]+', '"n_images": 1' + "0" * 400), "good.json", "invalid JSON: integer 1000000000"),
+    ("lone-surrogate", _text(lambda t: t.replace('"submitter": "b"', '"submitter": "b\\ud800"')), "good.json",
+     "submitter: string holds a lone surrogate U+D800"),
+    ("lone-surrogate-in-key", _text(lambda t: t.replace('"submitter": "b"', '"submitter": "b", "\\udfff": 1')), "good.json",
+     "(top level): a key holds a lone surrogate U+DFFF"),
+    ("nesting-100000", lambda good: b'{"notes": ' + b"[" * 100_000 + b"]" * 100_000 + b"}", "good.json", "invalid JSON: nested deeper than 32 levels"),
+    ("nesting-200", _text(lambda t: t.replace('"submitter": "b"', '"submitter": "b", "x": ' + "[" * 200 + "]" * 200)), "good.json",
+     "invalid JSON: nested deeper than 32 levels"),
+    ("ap-above-ap50", _edit(_ap_above_ap50), "good.json", "conditions.day.per_distance: AP 0."),
+    ("ci-reversed", _edit(_ci_reversed), "good.json", "is reversed (lo > hi)"),
+    ("ci-lo-infinite", _edit(_ci_lo_infinite), "good.json", "conditions.day.od50_ci95_m = [null, "),
+    ("n-environments", _edit(lambda s: s["conditions"]["night"].update(n_environments=999)), "good.json",
+     "conditions.night.n_environments = 999, but protocol 'smoke' has 4 environments"),
+    ("same-detections", _edit(_same_detections), "good.json", "conditions.day and conditions.night have the same detections_sha256"),
+    ("created-in-the-future", _edit(lambda s: s.update(created_at="9999-12-31T23:59:59Z")), "good.json",
+     "created_at 9999-12-31T23:59:59Z is in the future"),
 ]  # fmt: skip
 
 
@@ -259,7 +313,7 @@ def test_detections_of_another_system(app, world, tmp_path):
     assert res.exit_code == 2 and "--detections needs --groundtruth" in stderr
 
 
-@pytest.mark.parametrize("name", ["../escape", "a/b", "a\\b", ".hidden", "sp ace", "naïve", ""])
+@pytest.mark.parametrize("name", ["../escape", "a/b", "a\\b", ".hidden", "sp ace", "naïve", "", "trailing\n"])
 def test_unsafe_names_refused_when_building(app, world, name):
     before = tree_sha256(world["leaderboard"])
     res, stderr = _invoke(app, ["submit", world["root"] / "cam03" / "night", "--name", name, "--leaderboard", world["leaderboard"],
@@ -285,3 +339,132 @@ def test_build_refuses_changed_run_files(app, world, tmp_path):
     res, stderr = _invoke(app, args)
     assert res.exit_code == 2 and "sha256 differs from results.json's detections_sha256" in stderr, stderr
     assert tree_sha256(world["leaderboard"]) == before
+
+
+def test_created_at_allows_one_day_of_clock_skew(world):
+    from datetime import datetime, timedelta, timezone
+
+    from benchmark.leaderboard import SubmissionError, validate_submission
+
+    protocols = load_protocols(world["leaderboard"])
+    now = datetime(2025, 1, 2, 3, 4, 5, tzinfo=timezone.utc)
+    sub = copy.deepcopy(world["good"])
+    for ahead, ok in ((timedelta(0), True), (timedelta(hours=23), True), (timedelta(days=1, seconds=1), False)):
+        sub["created_at"] = (now + ahead).strftime("%Y-%m-%dT%H:%M:%SZ")
+        if ok:
+            validate_submission(sub, protocols=protocols, now=now)
+        else:
+            with pytest.raises(SubmissionError, match=r"^good: created_at 2025-01-03T03:04:06Z is in the future \(now 2025-01-02T03:04:05Z\)$"):
+                validate_submission(sub, protocols=protocols, source="good", now=now)
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (lambda s: s.update(submitter="\udcff"), "submitter: string holds a lone surrogate U+DCFF"),  # what a non-UTF-8 argv byte becomes
+        (lambda s: s.update(submitter="a\u2028b"), "submitter: string holds a control character or line break U+2028"),
+        (lambda s: s["conditions"]["day"].update(od50_sd_m=math.inf), "conditions.day.od50_sd_m: inf is not a finite number"),
+        (lambda s: s["conditions"]["day"]["per_distance"][0].update(ap=math.nan), "per_distance[0].ap: nan is not a finite number"),
+        (lambda s: s.update(notes="line one\n\tline two"), None),  # notes may hold line breaks and tabs
+        (lambda s: s.update(notes="bell \x07"), "notes: string holds a control character or line break U+0007"),
+    ],
+    ids=["surrogate", "line-separator", "inf", "nan", "notes-multiline", "notes-control"],
+)
+def test_in_memory_submissions_checked_too(world, edit, expected):
+    """`submit` validates what it built (e.g. a --submitter from argv) with the same rules as --check."""
+    from benchmark.leaderboard import SubmissionError, validate_submission
+
+    sub = copy.deepcopy(world["good"])
+    edit(sub)
+    protocols = load_protocols(world["leaderboard"])
+    if expected is None:
+        validate_submission(sub, protocols=protocols)
+        return
+    with pytest.raises(SubmissionError) as info:
+        validate_submission(sub, protocols=protocols, source="good")
+    assert str(info.value).startswith("good: ") and expected in str(info.value) and "\n" not in str(info.value)
+
+
+def test_check_name_is_anchored_at_the_very_end():
+    from benchmark.leaderboard import SubmissionError, check_name
+
+    assert check_name("good") == "good"
+    for name in ("good\n", "good\r", "\ngood", "a" * 81):
+        with pytest.raises(SubmissionError, match="unsafe submission name"):
+            check_name(name)
+
+
+def test_leaderboard_command_refuses_what_check_refuses(app, world, tmp_path):
+    """A lone surrogate in a submission used to pass --check and then break `benchmark leaderboard`."""
+    import shutil
+
+    lb = tmp_path / "leaderboard"
+    shutil.copytree(world["leaderboard"], lb)
+    assert _invoke(app, ["leaderboard", "--dir", lb])[0].exit_code == 0
+    text = dumps_submission(world["good"]).replace('"submitter": "b"', '"submitter": "b\\ud800"')
+    (lb / "submissions" / "good.json").write_text(text, encoding="utf-8")
+    before = tree_sha256(lb)
+    res, stderr = _invoke(app, ["leaderboard", "--dir", lb])
+    assert res.exit_code == 2
+    assert stderr.strip().splitlines() == [
+        "error: good.json: submitter: string holds a lone surrogate U+D800 (not valid Unicode; UTF-8 cannot encode it) (the table was not changed)"
+    ]
+    assert tree_sha256(lb) == before
+
+
+HOSTILE = "<img src=x onerror=alert(1)> | [click](http://evil.example) ![i](x.png) *b* _i_ `c` \\ ~s~ &lt; {x} #1 !"
+
+
+def _readme_row(text: str, name: str) -> str:
+    return next(line for line in text.splitlines() if f"submissions/{name}.json" in line)
+
+
+def test_markdown_escapes_free_text(world):
+    """Free text reaches README.md as literal text, as html.escape makes it literal in index.html."""
+    from benchmark.leaderboard import render_html, render_markdown
+    from benchmark.leaderboard.render import columns
+
+    protocols = load_protocols(world["leaderboard"])
+    sub = copy.deepcopy(world["good"])
+    sub["submitter"] = HOSTILE
+    sub["name"] = "my_sys.v2"
+    readme = render_markdown([sub], protocols)
+    row = _readme_row(readme, "my_sys.v2")
+    assert "\\<img src=x onerror=alert(1)\\> \\| \\[click\\](http://evil.example) \\!\\[i\\](x.png) \\*b\\* \\_i\\_ \\`c\\` \\\\ \\~s\\~ \\&lt; \\{x\\} \\#1 \\!" in row
+    assert "[my\\_sys.v2](submissions/my_sys.v2.json)" in row  # the link target is the (safe) file name, unescaped
+    keys = [c.key for c in columns(protocols["smoke"])]
+    cells = re.split(r"(?<!\\)\|", row)[1:-1]  # unescaped pipes only: the hostile text is one cell
+    assert len(cells) == len(keys) and cells[keys.index("submitter")].strip().startswith("\\<img")
+    page = render_html([sub], protocols)
+    assert "&lt;img src=x onerror=alert(1)&gt;" in page and "<img" not in page
+
+
+def test_markdown_renders_free_text_literally(world):
+    """Through a CommonMark renderer with GFM tables, the hostile submitter is one cell of plain text."""
+    import html as html_lib
+
+    from benchmark.leaderboard import render_markdown
+    from benchmark.leaderboard.render import columns
+
+    markdown_it = pytest.importorskip("markdown_it")  # installed with typer's rich; not a dependency of its own
+    protocols = load_protocols(world["leaderboard"])
+    sub = copy.deepcopy(world["good"])
+    sub["submitter"] = HOSTILE
+    rendered = markdown_it.MarkdownIt("commonmark").enable("table").render(render_markdown([sub], protocols))
+    keys = [c.key for c in columns(protocols["smoke"])]
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", rendered)
+    assert len(cells) == len(keys), cells
+    assert html_lib.unescape(cells[keys.index("submitter")]) == HOSTILE  # shown exactly as submitted
+    assert "<img" not in rendered and "<em>" not in rendered and "<code>" not in rendered and 'href="http://evil' not in rendered
+
+
+def test_committed_readme_unchanged_by_escaping():
+    """The escaping leaves today's table as it was: nothing in it needs escaping."""
+    from benchmark.leaderboard.render import _md
+
+    text = (REPO / "leaderboard" / "README.md").read_text()
+    rows = [line for line in text.splitlines() if line.startswith("| ") and "submissions/" in line]
+    assert len(rows) == 13
+    for row in rows:
+        for cell in row.strip("| ").split(" | ")[2:]:
+            assert _md(cell) == cell

@@ -13,9 +13,9 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from benchmark.cameras.spec import CameraSpec
+from benchmark.cameras.spec import PACKAGE_DATA_DIR, SPEC_DIR_CONTEXT, CameraSpec
 
-DATA_DIR = Path(__file__).parent / "data"
+DATA_DIR = PACKAGE_DATA_DIR
 
 
 def camera_names() -> list[str]:
@@ -51,21 +51,32 @@ def load_camera(name_or_path: str | int | Path) -> CameraSpec:
         mark = getattr(exc, "problem_mark", None)
         where = f" (line {mark.line + 1})" if mark is not None else ""
         raise ValueError(f"{path}: invalid YAML{where}: {getattr(exc, 'problem', exc)}") from None
-    return camera_from_dict(data, source=str(path))
+    return camera_from_dict(data, source=str(path), spec_dir=path.parent)
 
 
-def camera_from_dict(data: Any, source: str = "camera spec") -> CameraSpec:
-    """Validate a mapping into a :class:`CameraSpec` (one-line ValueError on failure)."""
+def camera_from_dict(data: Any, source: str = "camera spec", *, spec_dir: str | Path | None = None) -> CameraSpec:
+    """Validate a mapping into a :class:`CameraSpec` (one-line ValueError on failure).
+
+    ``spec_dir``: the folder of the spec file; a ``sensor.qe`` that is not a packaged
+    file must then exist there (relative to it) and is read from there. Without it (a
+    spec that comes from no file, e.g. a results.json dump) the file is looked up when
+    it is first read: packaged, else relative to the working folder.
+    """
     if not isinstance(data, dict):
         raise ValueError(f"{source}: expected a mapping of camera fields, got {type(data).__name__}")
+    context = {SPEC_DIR_CONTEXT: Path(spec_dir)} if spec_dir is not None else None
     try:
-        return CameraSpec.model_validate(data)
+        return CameraSpec.model_validate(data, context=context)
     except ValidationError as exc:
         err = exc.errors()[0]
         loc = ".".join(str(p) for p in err["loc"])
         allowed = _allowed(CameraSpec, err["loc"])
-        value = f" = {err['input']!r}" if err["type"] != "missing" else ""
-        raise ValueError(f"{source}: field '{loc}'{value}: {err['msg']}{allowed}") from None
+        msg = err["msg"]
+        if err["type"] == "value_error":  # our own checks: the message says it all
+            msg = msg.removeprefix("Value error, ")
+        shown = err["type"] != "missing" and not isinstance(err.get("input"), (dict, list))
+        value = f" = {err['input']!r}" if shown else ""
+        raise ValueError(f"{source}: field '{loc}'{value}: {msg}{allowed}") from None
 
 
 def _allowed(model: type[BaseModel], loc: tuple) -> str:

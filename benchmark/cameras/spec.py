@@ -5,15 +5,38 @@ and a validated range. The defaults describe the paper's camera (Liu et al., EI 
 4.38 mm diffraction-limited lens over a 2.688 x 1.512 mm Sony IMX363-like sensor, with
 the figures of ISETCam's ``sensorIMX363`` (see ``docs/camera.md``). Only the pixel
 pitch and the f-number differ between the 13 registry cameras.
+
+Geometry: the pixel array is ``width_px`` × ``height_px`` square pixels of ``pixel_um``,
+``width_px = round(active_width_mm / pixel_um)`` (likewise the height): the active area
+is rounded to whole pixels, and the field of view is the pixel array's,
+``2·atan(width_px · pixel_um / 2f)`` × ``2·atan(height_px · pixel_um / 2f)``, so pixels
+are square in angle by construction (docs/camera.md, "Field of view and geometry").
+
+A spec is validated as a whole (docs/camera.md, "Refused specs"): black level below the
+ADC white level, a ``qe`` file that is packaged or lies beside the spec file, a known
+illuminant, a pixel array of at least 16 × 16 and at most :data:`MAX_CAPTURE_GIB` of
+memory for one capture.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import math
+from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, computed_field, model_serializer, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationInfo,
+    computed_field,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
@@ -27,6 +50,45 @@ IMX363_ISO_SPEED = 270.0
 """ISO speed of ISETCam's ``sensorIMX363`` (its default, used by the paper)."""
 IMX363_ISO_UNITY_GAIN = 55.0
 """ISO at which the IMX363's analog gain is 1 (ISETCam: "for Pixel 4: ISO55")."""
+
+PACKAGE_DATA_DIR = Path(__file__).parent / "data"
+"""Where packaged spectral data (``imx363_qe.csv``) live (``registry.DATA_DIR``)."""
+
+MAX_CAPTURE_GIB = 4.0
+"""A spec whose one capture needs more memory than this (estimate) is refused."""
+CAPTURE_BYTES_PER_PIXEL = 256
+"""Peak memory of one capture per pixel, bytes: the 31-band float32 radiance on the
+pixel grid (124 B), the padded per-band FFTs and channel spectra, the float64 noise
+chain, the raw and the ISP's float32 planes. Measured: 226 B/px (1920 × 1080) and
+239 B/px (2688 × 1512) of peak RSS above the baseline for ``simulate``."""
+MIN_SIZE_PX = 16
+"""Fewest pixels per side (the demosaic and the exposure's central region need some)."""
+SPEC_DIR_CONTEXT = "spec_dir"
+"""Validation context key: the folder of the spec file (``qe`` user files resolve there)."""
+
+
+def _check_qe_syntax(value: str) -> str:
+    """``qe`` must be a relative POSIX path of a ``.csv`` inside its folder: no absolute
+    path or drive, no ``..``, no backslash, NUL or line break."""
+    bad = next((c for c in ("\\", "\0", "\n", "\r") if c in value), None)
+    if bad is not None:
+        raise ValueError(f"a relative path with '/' separators is expected, without {bad!r}")
+    if PurePosixPath(value).is_absolute() or PureWindowsPath(value).drive or value.startswith("~"):
+        raise ValueError("an absolute path is refused: name a packaged file (imx363_qe.csv) or a file "
+                         "beside the spec file")
+    if ".." in PurePosixPath(value).parts:
+        raise ValueError("'..' is refused: the file must lie in the spec file's folder or below it")
+    if PurePosixPath(value).suffix.lower() != ".csv":
+        raise ValueError("a .csv file is expected (columns wavelength_nm, qe_r, qe_g, qe_b)")
+    return value
+
+
+def packaged_qe(name: str) -> Path | None:
+    """The packaged QE file called ``name`` (a bare file name), or None."""
+    if "/" in name:
+        return None
+    path = PACKAGE_DATA_DIR / name
+    return path if path.is_file() else None
 
 
 class OpticsSpec(BaseModel):
@@ -49,8 +111,9 @@ class SensorSpec(BaseModel):
     active_width_mm: float = Field(REFERENCE_ACTIVE_WIDTH_MM, gt=0.0, le=50.0)
     active_height_mm: float = Field(REFERENCE_ACTIVE_HEIGHT_MM, gt=0.0, le=50.0)
     cfa: Literal["RGGB"] = "RGGB"
-    qe: str = Field("imx363_qe.csv", min_length=1)
-    """Packaged CSV name (``benchmark/cameras/data``) or a path; columns
+    qe: str = Field("imx363_qe.csv", min_length=1, max_length=255)
+    """Packaged CSV name (``benchmark/cameras/data``), else a relative path from the spec
+    file's folder (no absolute path, no ``..``); columns
     ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``."""
     fill_factor: float = Field(1.0, gt=0.0, le=1.0)
     well_capacity_e: float = Field(6000.0, gt=0.0, le=1e7)
@@ -68,6 +131,38 @@ class SensorSpec(BaseModel):
     fpn_seed: int = Field(0, ge=0)
     """Seed of the fixed-pattern noise maps (PRNU, DSNU): a property of the sensor
     unit, the same in every capture, independent of the capture seed."""
+
+    _qe_path: str | None = PrivateAttr(None)
+    """Resolved user QE file (a spec loaded from a file); None: packaged or unresolved."""
+
+    @field_validator("qe")
+    @classmethod
+    def _qe_is_a_relative_csv(cls, value: str) -> str:
+        return _check_qe_syntax(value)
+
+    @model_validator(mode="after")
+    def _whole_sensor(self, info: ValidationInfo) -> "SensorSpec":
+        if self.black_level_dn >= self.white_level_dn:
+            raise ValueError(f"black_level_dn {self.black_level_dn} must be below the ADC white level "
+                             f"{self.white_level_dn} (2^adc_bits - 1 for adc_bits {self.adc_bits})")
+        if min(self.width_px, self.height_px) < MIN_SIZE_PX:
+            raise ValueError(f"the pixel array is {self.width_px} x {self.height_px} px (active area "
+                             f"{self.active_width_mm:g} x {self.active_height_mm:g} mm at {self.pixel_um:g} um); "
+                             f"at least {MIN_SIZE_PX} px per side")
+        gib = self.capture_memory_bytes / 2**30
+        if gib > MAX_CAPTURE_GIB:
+            raise ValueError(f"the pixel array is {self.width_px} x {self.height_px} px "
+                             f"({self.width_px * self.height_px / 1e6:.1f} Mpx: {self.active_width_mm:g} x "
+                             f"{self.active_height_mm:g} mm at {self.pixel_um:g} um); one capture needs about "
+                             f"{gib:.1f} GiB, above the {MAX_CAPTURE_GIB:g} GiB limit: use larger pixels or a "
+                             "smaller active area")
+        spec_dir = (info.context or {}).get(SPEC_DIR_CONTEXT) if info is not None else None
+        if spec_dir is not None and packaged_qe(self.qe) is None:
+            path = Path(spec_dir) / self.qe
+            if not path.is_file():
+                raise ValueError(f"qe {self.qe!r}: no packaged file of that name and no file {path}")
+            self._qe_path = str(path.resolve())
+        return self
 
     @computed_field
     @property
@@ -91,6 +186,33 @@ class SensorSpec(BaseModel):
     @property
     def white_level_dn(self) -> int:
         return 2**self.adc_bits - 1
+
+    @property
+    def array_width_mm(self) -> float:
+        """Width of the pixel array, mm: ``width_px`` × ``pixel_um`` (the active area
+        rounded to whole pixels); it sets the horizontal field of view."""
+        return self.width_px * self.pixel_um * 1e-3
+
+    @property
+    def array_height_mm(self) -> float:
+        return self.height_px * self.pixel_um * 1e-3
+
+    @property
+    def capture_memory_bytes(self) -> int:
+        """Estimated peak memory of one capture (:data:`CAPTURE_BYTES_PER_PIXEL` per pixel)."""
+        return self.width_px * self.height_px * CAPTURE_BYTES_PER_PIXEL
+
+    @property
+    def qe_path(self) -> Path:
+        """The QE file this sensor reads: the resolved user file of a spec loaded from a
+        file, else the packaged file of that name, else ``qe`` from the working folder
+        (a spec validated without a file). ValueError if it does not exist."""
+        if self._qe_path is not None:
+            return Path(self._qe_path)
+        path = packaged_qe(self.qe) or Path(self.qe)
+        if not path.is_file():
+            raise ValueError(f"sensor.qe: QE file {self.qe!r} not found (packaged name or a file beside the spec)")
+        return path
 
 
 class ExposureSpec(BaseModel):
@@ -159,6 +281,19 @@ class ISPSpec(BaseModel):
     """``none``: no gains, as ISETCam's default illuminant correction ('None')."""
     illuminant: str = "D65"
     """Illuminant for ``known_illuminant`` white balance (a colour-science name)."""
+
+    @field_validator("illuminant")
+    @classmethod
+    def _known_illuminant(cls, value: str) -> str:
+        if value == "D65":  # the default: no need to import colour-science
+            return value
+        import colour
+
+        try:
+            colour.SDS_ILLUMINANTS[value]
+        except (KeyError, TypeError, ValueError):
+            raise ValueError(f"unknown illuminant {value!r} (colour-science names, e.g. D65, A, D50, F2)") from None
+        return value
     output: Literal["srgb8", "linear"] = "srgb8"
     color_transform: Literal["checker_srgb", "iset_mcc"] = "checker_srgb"
     """``checker_srgb``: the ColorChecker-fitted matrix from white-balanced camera RGB to
@@ -206,6 +341,35 @@ class CameraSpec(BaseModel):
     @property
     def f_number(self) -> float:
         return self.optics.f_number
+
+    @property
+    def tan_half_width(self) -> float:
+        """tan of half the horizontal field: half the pixel array's width over the focal length."""
+        return self.sensor.array_width_mm / 2.0 / self.optics.focal_length_mm
+
+    @property
+    def tan_half_height(self) -> float:
+        return self.sensor.array_height_mm / 2.0 / self.optics.focal_length_mm
+
+    @property
+    def hfov_deg(self) -> float:
+        """Horizontal field of view, degrees: 2·atan(width_px · pixel / 2f)."""
+        return math.degrees(2.0 * math.atan(self.tan_half_width))
+
+    @property
+    def vfov_deg(self) -> float:
+        """Vertical field of view, degrees: 2·atan(height_px · pixel / 2f)."""
+        return math.degrees(2.0 * math.atan(self.tan_half_height))
+
+    @property
+    def ifov_mrad(self) -> float:
+        """Instantaneous field of view of one pixel on the axis, mrad: pixel / f."""
+        return self.pixel_um / self.optics.focal_length_mm
+
+    @property
+    def nyquist_cy_per_mm(self) -> float:
+        """Sampling Nyquist frequency on the sensor, cycles/mm: 1 / (2 · pixel)."""
+        return 500.0 / self.pixel_um
 
     def canonical_json(self) -> str:
         """The resolved spec (defaults filled in) as sorted, compact JSON."""

@@ -60,7 +60,19 @@ def _output_layout(session: ort.InferenceSession, path: Path) -> tuple[tuple[int
         out = session.run(None, {session.get_inputs()[0].name: x})[0]
     except Exception as exc:
         raise DetectorError(f"{path}: model failed on a {hw[0]}x{hw[1]} probe input ({str(exc).splitlines()[0][:120]})") from None
+    check_finite(out, path, f"a {hw[0]}x{hw[1]} probe input")
     return hw, tuple(out.shape)
+
+
+def check_finite(output: np.ndarray, path: Path, what: str) -> None:
+    """A model whose outputs hold NaN or infinity is broken: NaN scores pass no threshold,
+    so it would silently find nothing. Refuse it with a one-line :class:`DetectorError`."""
+    output = np.asarray(output)
+    if output.dtype.kind == "f" and not np.isfinite(output).all():
+        bad = int(np.count_nonzero(~np.isfinite(output)))
+        share = "all" if bad == output.size else f"{bad} of {output.size}"
+        raise DetectorError(f"{path}: the model's outputs are not finite on {what} ({share} values are NaN or "
+                            "infinite); the model file is broken")
 
 
 def infer_family(session: ort.InferenceSession, path: Path) -> str:
@@ -121,6 +133,7 @@ class OnnxDetector:
         for start in range(0, len(canvases), per_run):
             x = np.stack([fam.to_input(c) for c in canvases[start : start + per_run]])
             y = self.session.run(None, {self._input_name: x})[0]
+            check_finite(y, self.path, f"a {h}x{w} input")
             outs.extend(list(y))
         return outs
 

@@ -1,4 +1,4 @@
-"""The protocols a leaderboard accepts: manifest hashes, distances and conditions.
+"""The protocols a leaderboard accepts: manifest hashes, distances, conditions and environments.
 
 Packaged in ``data/protocols.yaml``; a leaderboard folder may carry its own
 ``protocols.yaml`` (same format), which then replaces the packaged one, so a maintainer
@@ -26,6 +26,13 @@ class Protocol:
     distances_m: tuple[float, ...]
     conditions: tuple[str, ...]
     required_conditions: tuple[str, ...]
+    n_environments: int | None = None  # environments of the collection; None: not checked
+
+
+def _count(value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"n_environments must be a positive integer, got {value!r}")
+    return value
 
 
 def _parse(text: str, source: str) -> dict[str, Protocol]:
@@ -40,6 +47,7 @@ def _parse(text: str, source: str) -> dict[str, Protocol]:
                 distances_m=tuple(float(d) for d in p["distances_m"]),
                 conditions=tuple(str(c) for c in p["conditions"]),
                 required_conditions=tuple(str(c) for c in p["required_conditions"]),
+                n_environments=None if p.get("n_environments") is None else _count(p["n_environments"]),
             )
     except (yaml.YAMLError, KeyError, TypeError, AttributeError, ValueError) as exc:
         raise ValueError(f"{source}: invalid protocols file ({type(exc).__name__}: {exc})".splitlines()[0]) from None

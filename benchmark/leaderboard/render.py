@@ -18,6 +18,7 @@ import base64
 import hashlib
 import html
 import math
+import re
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -117,8 +118,15 @@ def _by_protocol(submissions: list[dict], protocols: dict[str, Protocol]) -> lis
     return [(p, ranked([s for s in submissions if s["collection"]["protocol"] == name])) for name, p in protocols.items()]
 
 
+# Markdown's inline syntax: a backslash before any of these shows it as itself (CommonMark
+# "backslash escapes"), as html.escape does for the page; "|" would end the table cell.
+_MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|~&!#])")
+_MD_BREAK = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")  # line breaks and other controls: one table row
+
+
 def _md(text: str) -> str:
-    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+    """``text`` shown as itself in a Markdown table cell: no links, images, HTML, emphasis or code."""
+    return _MD_SPECIAL.sub(r"\\\1", _MD_BREAK.sub(" ", text))
 
 
 def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
@@ -137,7 +145,7 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
     ]  # fmt: skip
     for protocol, subs in _by_protocol(submissions, protocols):
         cols = columns(protocol)
-        lines += [f"## {protocol.name}", "", f"{protocol.description}.", ""]
+        lines += [f"## {_md(protocol.name)}", "", f"{_md(protocol.description)}.", ""]
         if not subs:
             lines += ["No submissions yet.", ""]
             continue

@@ -1,12 +1,15 @@
 """Validation of a submission: file, JSON, schema, then what the schema cannot say.
 
 Each refusal is a :class:`SubmissionError` with a one-line reason. The checks beyond the
-schema: the camera spec's sha256 matches its content; the protocol and manifest hash are
-accepted (:mod:`benchmark.leaderboard.protocols`); every condition has exactly the
-protocol's distances and the required conditions are there; OD50 follows from the AP
-curve (:func:`benchmark.scoring.od50`); the name is new on the leaderboard; and, given the
-detections file and ground truth, AP recomputed with :func:`benchmark.scoring.ap_by_distance`
-equals the claimed AP within 1e-6.
+schema: no string holds a control character, line break or lone surrogate and no number is
+infinite (:func:`benchmark.leaderboard.schema.check_values`); ``created_at`` is a real date,
+not in the future; the camera spec's sha256 matches its content; the protocol and manifest
+hash are accepted (:mod:`benchmark.leaderboard.protocols`); every condition has exactly the
+protocol's distances, the protocol's number of environments and its own detections file,
+and the required conditions are there; AP never exceeds AP50; OD50 follows from the AP
+curve (:func:`benchmark.scoring.od50`) and lies inside its ordered 95 % interval; the name
+is new on the leaderboard; and, given the detections file and ground truth, AP recomputed
+with :func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
 """
 
 from __future__ import annotations
@@ -15,23 +18,24 @@ import hashlib
 import json
 import math
 import re
-from datetime import datetime
+from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 from benchmark.leaderboard.files import sha256_file
 from benchmark.leaderboard.protocols import Protocol, load_protocols
-from benchmark.leaderboard.schema import SubmissionError, check_schema, loads_strict
+from benchmark.leaderboard.schema import SubmissionError, check_schema, check_values, loads_strict
 
 MAX_SUBMISSION_BYTES = 5 * 1024 * 1024
-NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$")
+NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
 AP_TOLERANCE = 1e-6
 OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
+CLOCK_TOLERANCE = timedelta(days=1)  # created_at may be this far ahead of the checker's clock
 SUBMISSIONS = "submissions"
 
 
 def check_name(name: str) -> str:
     """``name`` if it is a safe file stem (letters, digits, ``._-``; no separators, no leading dot)."""
-    if not isinstance(name, str) or not NAME_PATTERN.match(name):
+    if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):  # fullmatch: "$" would accept a trailing newline
         raise SubmissionError(
             f"unsafe submission name {name!r}: use 1-80 letters, digits, '.', '_' or '-', starting with a letter or digit"
         )
@@ -145,6 +149,11 @@ def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) ->
     if extra:
         raise SubmissionError(f"{where}: distance {extra[0]:g} m is not one of protocol {protocol.name!r}'s distances")
     rows = sorted(cond["per_distance"], key=lambda r: r["distance_m"])
+    for r in rows:
+        if r["ap"] > r["ap50"] + AP_TOLERANCE:
+            raise SubmissionError(
+                f"{where}: AP {r['ap']:.6f} exceeds AP50 {r['ap50']:.6f} at {r['distance_m']:g} m (AP averages IoU 0.50:0.95, so it cannot)"
+            )
     expected = _finite_or_none(od50([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
     claimed = cond["od50_m"]
     if (expected is None) != (claimed is None) or (
@@ -152,17 +161,45 @@ def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) ->
     ):
         show = "inf" if expected is None else f"{expected:.3f} m"
         raise SubmissionError(f"{source}: conditions.{cname}.od50_m = {claimed} does not follow from its AP per distance (OD50 = {show})")
+    _check_interval(cname, cond, source)
+    if protocol.n_environments is not None and cond["n_environments"] != protocol.n_environments:
+        raise SubmissionError(
+            f"{source}: conditions.{cname}.n_environments = {cond['n_environments']}, but protocol {protocol.name!r} has {protocol.n_environments} environments"
+        )
 
 
-def validate_submission(data: object, *, protocols: dict[str, Protocol] | None = None, source: str = "submission") -> dict:
-    """Schema and consistency checks of a parsed submission; returns it unchanged."""
+def _check_interval(cname: str, cond: dict, source: str) -> None:
+    """``od50_ci95_m`` = [lo, hi] is ordered (null = +inf). It need not hold ``od50_m``: the
+    percentile ends are order statistics of the bootstrap distribution
+    (:func:`benchmark.scoring.percentile_interval`), which a skewed OD50 may leave outside."""
+    def show(v: float) -> str:
+        return "null" if v == math.inf else f"{v:g}"
+
+    lo, hi = (math.inf if v is None else float(v) for v in cond["od50_ci95_m"])
+    where = f"{source}: conditions.{cname}"
+    if lo > hi:
+        raise SubmissionError(f"{where}.od50_ci95_m = [{show(lo)}, {show(hi)}] is reversed (lo > hi)")
+
+
+def validate_submission(
+    data: object, *, protocols: dict[str, Protocol] | None = None, source: str = "submission", now: datetime | None = None
+) -> dict:
+    """Schema and consistency checks of a parsed submission; returns it unchanged.
+
+    ``now``: the checker's clock (default: the current UTC time); ``created_at`` may be at
+    most :data:`CLOCK_TOLERANCE` ahead of it.
+    """
+    check_values(data, source)
     check_schema(data, source)
     assert isinstance(data, dict)
     check_name(data["name"])
     try:
-        datetime.strptime(data["created_at"], "%Y-%m-%dT%H:%M:%SZ")
+        created = datetime.strptime(data["created_at"], "%Y-%m-%dT%H:%M:%SZ").replace(tzinfo=timezone.utc)
     except ValueError:
         raise SubmissionError(f"{source}: created_at {data['created_at']!r} is not a valid UTC date and time") from None
+    now = datetime.now(timezone.utc) if now is None else now
+    if created > now + CLOCK_TOLERANCE:
+        raise SubmissionError(f"{source}: created_at {data['created_at']} is in the future (now {now:%Y-%m-%dT%H:%M:%SZ})")
     _check_camera(data, source)
     protocols = load_protocols() if protocols is None else protocols
     col = data["collection"]
@@ -187,6 +224,14 @@ def validate_submission(data: object, *, protocols: dict[str, Protocol] | None =
                 f"{source}: conditions.{cname}: not a condition of protocol {protocol.name!r} (allowed: {', '.join(protocol.conditions)})"
             )
         _check_condition(cname, conditions[cname], protocol, source)
+    seen: dict[str, str] = {}
+    for cname in sorted(conditions):
+        digest = conditions[cname]["detections_sha256"]
+        if digest in seen:
+            raise SubmissionError(
+                f"{source}: conditions.{seen[digest]} and conditions.{cname} have the same detections_sha256 {digest[:12]}... (each condition is its own run)"
+            )
+        seen[digest] = cname
     return data
 
 

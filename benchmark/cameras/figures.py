@@ -1,0 +1,146 @@
+"""What a camera spec implies: field of view, IFOV, Nyquist, saturation, dynamic range,
+SNR at a stated reference, and warnings where the spec hides something (a well the gain
+makes unreachable). ``benchmark cameras show`` prints them (docs/camera.md, "Field of
+view and geometry", "What a spec implies").
+
+Every figure is computed from the spec with the pipeline's own formulas: saturation by
+:func:`benchmark.sensor.saturation_electrons`, the reference signal by
+:func:`benchmark.camera.electron_rate` on a uniform scene.
+"""
+
+from __future__ import annotations
+
+import math
+
+from benchmark.cameras.spec import MAX_CAPTURE_GIB, CameraSpec
+
+REFERENCE_ILLUMINANCE_LUX = 100.0
+"""Illuminance of the SNR reference: a 18 % grey Lambertian surface lit by 100 lux of D65."""
+REFERENCE_REFLECTANCE = 0.18
+REFERENCE_ILLUMINANT = "D65"
+
+
+def reference_exposure_s(camera: CameraSpec) -> float:
+    """The exposure of the SNR reference: ``exposure_s`` for a ``fixed`` policy, else the
+    cap ``max_exposure_s`` (the longest any other policy may take)."""
+    e = camera.exposure
+    return float(e.exposure_s if e.mode == "fixed" else e.max_exposure_s)
+
+
+def reference_signal_e_per_s(camera: CameraSpec) -> float:
+    """Signal rate of a green pixel on the axis, e⁻/s, viewing a 18 % grey Lambertian
+    surface under 100 lux of D65 (luminance 0.18 × 100 / π cd/m²): the pipeline's optics
+    and sensor response on a uniform scene, diffraction off (it does not change a
+    uniform field)."""
+    from benchmark.camera import electron_rate
+    from benchmark.isp import illuminant_spectrum
+    from metricscenes.geometry import REFERENCE_EXTENT
+    from metricscenes.photometry import radiance_to_xyz
+    from metricscenes.radiance import SpectralScene
+
+    spectrum = illuminant_spectrum(REFERENCE_ILLUMINANT)
+    luminance = REFERENCE_REFLECTANCE * REFERENCE_ILLUMINANCE_LUX / math.pi
+    radiance = spectrum * (luminance / float(radiance_to_xyz(spectrum)[1]))
+    scene = SpectralScene.uniform(radiance, rows=8, cols=8)
+    rate = electron_rate(scene, camera, shape_px=(8, 8), extent=REFERENCE_EXTENT, diffraction=False)
+    return float(rate[1].mean())
+
+
+def camera_figures(camera: CameraSpec) -> dict:
+    """What the spec implies, as a JSON-ready dict (units in the keys)."""
+    from benchmark.sensor import saturation_electrons, signal_volts_per_electron
+
+    s = camera.sensor
+    volts_per_e = signal_volts_per_electron(s)
+    adc_e = (s.white_level_dn - s.black_level_dn) * s.lsb_v / volts_per_e
+    saturation = saturation_electrons(s)
+    e_per_dn = s.lsb_v / volts_per_e
+    # Noise floor: read noise, DSNU (volts before the analog gain) and the ADC's LSB/√12.
+    dsnu_e = s.dsnu_v / (s.conversion_gain_uv_per_e * 1e-6)
+    floor = math.sqrt(s.read_noise_e**2 + dsnu_e**2 + e_per_dn**2 / 12.0)
+    t = reference_exposure_s(camera)
+    rate = reference_signal_e_per_s(camera)
+    signal = min(rate * t, saturation)
+    dark = s.dark_current_e_per_s * t
+    noise = math.sqrt(signal + dark + (s.prnu_fraction * signal) ** 2 + floor**2)
+    snr = signal / noise if noise > 0 else math.inf
+    return {
+        "focal_length_mm": camera.optics.focal_length_mm,
+        "size_px": [camera.width_px, camera.height_px],
+        "pixel_array_mm": [round(s.array_width_mm, 6), round(s.array_height_mm, 6)],
+        "fov_deg": {"horizontal": round(camera.hfov_deg, 4), "vertical": round(camera.vfov_deg, 4)},
+        "ifov_mrad": round(camera.ifov_mrad, 6),
+        "nyquist_cy_per_mm": round(camera.nyquist_cy_per_mm, 4),
+        "saturation_e": round(saturation, 1),
+        "saturation_limited_by": "adc" if adc_e < s.well_capacity_e else "well",
+        "well_capacity_e": s.well_capacity_e,
+        "adc_saturation_e": round(adc_e, 1),
+        "e_per_dn": round(e_per_dn, 4),
+        "noise_floor_e": round(floor, 3),
+        "dynamic_range_db": round(20 * math.log10(saturation / floor), 2) if floor > 0 else None,
+        "snr_reference": {
+            "scene": f"{REFERENCE_REFLECTANCE:.0%} grey Lambertian, {REFERENCE_ILLUMINANCE_LUX:g} lux "
+                     f"{REFERENCE_ILLUMINANT}, green pixel on the axis, no ISP",
+            "exposure_s": t,
+            "signal_e": round(signal, 2),
+            "clipped": rate * t > saturation,
+            "snr": round(snr, 3),
+            "snr_db": round(20 * math.log10(snr), 2) if 0 < snr < math.inf else None,
+        },
+        "capture_memory_gib": round(s.capture_memory_bytes / 2**30, 3),
+    }
+
+
+def camera_warnings(camera: CameraSpec, figures: dict | None = None) -> list[str]:
+    """One line per thing the spec implies but does not say."""
+    from benchmark.camera import camera_extent
+    from metricscenes.geometry import REFERENCE_EXTENT, extent_within, fov_deg
+
+    f = figures or camera_figures(camera)
+    s = camera.sensor
+    out = []
+    adc_e, well = f["adc_saturation_e"], s.well_capacity_e
+    if adc_e < well:
+        usable_gain = s.analog_gain * adc_e / well
+        out.append(f"the ADC clips at {adc_e:.0f} e- (voltage swing / (conversion gain x analog gain "
+                   f"{s.analog_gain:.3g}), less the black level) before the {well:.0f} e- well fills: "
+                   f"{1 - adc_e / well:.0%} of the well is unreachable (analog_gain <= {usable_gain:.3g} reaches it)")
+    elif well < 0.99 * adc_e:
+        dn = s.black_level_dn + well / f["e_per_dn"]
+        out.append(f"the {well:.0f} e- well fills at {dn:.0f} DN, below the ADC white level {s.white_level_dn} DN: "
+                   f"{1 - well / adc_e:.0%} of the codes above black are never used")
+    for axis, written, px in (("width", s.active_width_mm, s.array_width_mm),
+                              ("height", s.active_height_mm, s.array_height_mm)):
+        if abs(written - px) > 1e-6 * written:
+            out.append(f"active {axis} {written:g} mm is {written * 1000 / s.pixel_um:.2f} pixels of {s.pixel_um:g} um: "
+                       f"the pixel array ({px:.6g} mm) sets the field of view")
+    if not extent_within(camera_extent(camera), REFERENCE_EXTENT):
+        fh, fv = fov_deg(REFERENCE_EXTENT)
+        out.append(f"the field {camera.hfov_deg:.2f}° x {camera.vfov_deg:.2f}° exceeds the reference collection "
+                   f"field {fh:.2f}° x {fv:.2f}°: runs on collections with that field are refused")
+    if f["snr_reference"]["clipped"]:
+        out.append("the SNR reference saturates at the reference exposure (the figure is at saturation)")
+    if f["capture_memory_gib"] > MAX_CAPTURE_GIB / 2:
+        out.append(f"one capture needs about {f['capture_memory_gib']:.1f} GiB")
+    return out
+
+
+def figure_rows(figures: dict) -> list[tuple[str, str]]:
+    """(label, value) rows of :func:`camera_figures` for a table."""
+    snr = figures["snr_reference"]
+    dr = figures["dynamic_range_db"]
+    snr_text = (f"{snr['snr']:.1f} ({snr['snr_db']:.1f} dB)" if snr["snr_db"] is not None else "inf") + \
+        f" at {snr['signal_e']:.0f} e-, {snr['exposure_s'] * 1e3:g} ms: {snr['scene']}"
+    return [
+        ("field of view", f"{figures['fov_deg']['horizontal']:.2f}° x {figures['fov_deg']['vertical']:.2f}° "
+                          f"(f {figures['focal_length_mm']:g} mm, pixel array {figures['pixel_array_mm'][0]:.4g} x "
+                          f"{figures['pixel_array_mm'][1]:.4g} mm)"),
+        ("IFOV", f"{figures['ifov_mrad']:.4g} mrad per pixel (on the axis)"),
+        ("Nyquist", f"{figures['nyquist_cy_per_mm']:.1f} cy/mm"),
+        ("saturation", f"{figures['saturation_e']:.0f} e- ({figures['saturation_limited_by']}; well "
+                       f"{figures['well_capacity_e']:.0f} e-, ADC {figures['adc_saturation_e']:.0f} e-)"),
+        ("dynamic range", (f"{dr:.1f} dB" if dr is not None else "inf") +
+         f" (saturation / noise floor {figures['noise_floor_e']:.2f} e-: read, DSNU, LSB/sqrt(12))"),
+        ("SNR reference", snr_text),
+        ("memory per capture", f"about {figures['capture_memory_gib']:.2f} GiB"),
+    ]
