@@ -11,7 +11,9 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmark.cli_cameras import app as cameras_app
-from benchmark import cli_detect, cli_leaderboard
+from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
+from benchmark import cli_detect, cli_leaderboard, compare
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from metricscenes.cli import progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
@@ -19,10 +21,23 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show, measure MTF50.")
 cli_detect.register(app)
 cli_leaderboard.register(app)
+compare.register(app)
 console = Console()
 err = Console(stderr=True)
 EXPOSURE_HELP = ("exposure policy for every camera, replacing the camera's own: auto_peak (the paper's), mean_level, "
                  "percentile:P, hdr[:RATIO], fixed:SECONDS, each but fixed with an optional @LEVEL (docs/camera.md)")
+
+
+SUBSET_ENV_HELP = "a quick try on some environments only: ids and ranges such as 0-2,5 (marked as a subset run)"
+SUBSET_DIST_HELP = "a quick try at some distances only, in metres: 25,50 (marked as a subset run)"
+CLASS_MAP_HELP = ("for a detector whose classes are not COCO's 80: the COCO class of each model class, in order "
+                  "('car' for a single-class car detector, 'person,-,car'; '-' drops one; docs/detection.md)")
+
+
+def subset_text(subset: dict) -> str:
+    envs = ",".join(map(str, subset["environments"]))
+    dists = ",".join(f"{d:g}" for d in subset["distances_m"])
+    return f"subset run (environments {envs}; distances {dists} m): a quick try, not a full run — `benchmark submit` refuses it"
 
 
 def fail(message: str, code: int = 2) -> None:
@@ -39,28 +54,31 @@ def run(
     condition: Annotated[str, typer.Option(help="a condition of the collection (day, dusk, night)")] = "day",
     model: Annotated[str, typer.Option(help="detector: registry name or .onnx path")] = "yolov5n-dynamic",
     input_size: Annotated[str, typer.Option(
-        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = "multiscale",
+        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = DEFAULT_INPUT_SIZE,
     seed: Annotated[int, typer.Option(help="sensor noise seed")] = 0,
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the camera's sRGB images")] = True,
     backend: Annotated[str, typer.Option(help="faster-coco-eval | pycocotools")] = "faster-coco-eval",
     exposure: Annotated[Optional[str], typer.Option(help=EXPOSURE_HELP)] = None,
+    environments: Annotated[Optional[str], typer.Option(help=SUBSET_ENV_HELP)] = None,
+    distances: Annotated[Optional[str], typer.Option(help=SUBSET_DIST_HELP)] = None,
+    class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
 ) -> None:
     """Simulate one camera on a collection, detect cars, print AP per distance."""
     from benchmark.cameras import load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.exposure import format_exposure, parse_exposure, with_exposure
-    from benchmark.run import check_out_dir, run_camera
+    from benchmark.run import check_out_dir, run_camera, subset_collection
     from metricscenes.store import Collection, CollectionError
 
     try:
         check_out_dir(out)
         policy = parse_exposure(exposure) if exposure is not None else None
         cam = with_exposure(load_camera(camera), policy)
-        col = Collection.open(collection)
+        col = subset_collection(Collection.open(collection), environments, distances)
         if condition not in col.condition_names:
             fail(f"unknown condition {condition!r} (this collection has: {', '.join(col.condition_names)})")
-        detector = load_detector(model, input_size=input_size, threads=threads)
+        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
     try:  # a damaged array or a broken model is found on the way: nothing is written (run_camera stages)
@@ -80,6 +98,8 @@ def run(
         table.add_row(f"{row['distance_m']:g}", f"{row['ap']:.3f}", f"{row['ap50']:.3f}", str(row["n_images"]))
     console.print(table)
     console.print(od50_text(results["od50_m"]))
+    if results.get("subset"):
+        console.print(subset_text(results["subset"]))
     console.print(f"wrote {out / 'results.json'}")
 
 
@@ -91,20 +111,23 @@ def sweep(
     conditions: Annotated[str, typer.Option(help="comma list of the collection's conditions")] = "day,night",
     model: Annotated[str, typer.Option(help="detector: registry name or .onnx path")] = "yolov5n-dynamic",
     input_size: Annotated[str, typer.Option(
-        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = "multiscale",
-    resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples of OD50 (over environments)")] = 1000,
+        help="native | multiscale (native + 640, the reference) | an integer such as 640")] = DEFAULT_INPUT_SIZE,
+    resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples of OD50 (over environments)")] = BOOTSTRAP_RESAMPLES,
     seed: Annotated[int, typer.Option(help="sensor noise and bootstrap seed")] = 0,
     mtf_source: Annotated[str, typer.Option(help="MTF50 of each camera: measured | analytic | published")] = "measured",
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the cameras' sRGB images (for the report's strips)")] = True,
     exposure: Annotated[Optional[str], typer.Option(help=EXPOSURE_HELP)] = None,
+    environments: Annotated[Optional[str], typer.Option(help=SUBSET_ENV_HELP)] = None,
+    distances: Annotated[Optional[str], typer.Option(help=SUBSET_DIST_HELP)] = None,
+    class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
     from benchmark import sweep as sweep_module
     from benchmark.cameras import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.exposure import format_exposure, parse_exposure
-    from benchmark.run import check_out_dir
+    from benchmark.run import check_out_dir, subset_collection
     from metricscenes.store import Collection, CollectionError
 
     try:
@@ -112,7 +135,7 @@ def sweep(
         policy = parse_exposure(exposure) if exposure is not None else None
         names = camera_names() if cameras.strip().lower() == "all" else [c.strip() for c in cameras.split(",") if c.strip()]
         cams = [load_camera(name) for name in names]
-        col = Collection.open(collection)
+        col = subset_collection(Collection.open(collection), environments, distances)
         conds = [c.strip() for c in conditions.split(",") if c.strip()]
         known = col.condition_names
         for condition in conds:
@@ -120,7 +143,7 @@ def sweep(
                 fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
         if mtf_source not in sweep_module.MTF_SOURCES:
             fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF_SOURCES)}, got {mtf_source!r}")
-        detector = load_detector(model, input_size=input_size, threads=threads)
+        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
     if not cams or not conds:
@@ -150,10 +173,12 @@ def sweep(
         cells = []
         for condition in conds:
             od, sd = by_condition.loc[condition, "od50_m"], by_condition.loc[condition, "sd_m"]
-            cells.append("∞" if od == float("inf") else f"{od:.1f} ± {sd:.1f}" if sd == sd else f"{od:.1f}")
+            cells.append(sweep_module.od50_cell(by_condition.loc[condition]))
         mtf = rows["mtf50_cy_per_mm"].iloc[0]
         table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})", *cells)
     console.print(table)
+    if getattr(col, "subset", None):
+        console.print(subset_text(col.subset))
     console.print(f"wrote {out / 'sweep.csv'}, {out / 'od50.csv'}")
 
 

@@ -114,7 +114,7 @@ def mtf_command(
 ) -> None:
     """Measure MTF50 (ISO 12233 e-SFR through optics + sensor + demosaic)."""
     from benchmark.cameras.spec import isp_preset
-    from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
+    from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm, mtf_readings
 
     cams = _load(names or [])
     if esfr not in ("iso", "isetcam"):
@@ -133,7 +133,8 @@ def mtf_command(
             m = measure_mtf50(cam, esfr=esfr)
         except ValueError as exc:
             _fail(f"{cam.name}: {exc}")
-        curves.append((cam.name, m["freq_cy_per_mm"], m["mtf"]))
+        curves.append({"name": cam.name, "pixel_um": cam.pixel_um, "freq_cy_per_mm": m["freq_cy_per_mm"], "mtf": m["mtf"]})
+        read = mtf_readings(m["freq_cy_per_mm"], m["mtf"], cam.pixel_um)  # MTF30, MTF10 off the same curve
         results.append({
             "name": cam.name,
             "pixel_um": cam.pixel_um,
@@ -142,6 +143,11 @@ def mtf_command(
             "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(cam.pixel_um, cam.f_number), 2),
             "mtf50_group": cam.mtf50_group_cy_per_mm,
             "nyquist_cy_per_mm": round(500.0 / cam.pixel_um, 2),
+            "mtf50_cy_per_px": _round(m["mtf50_cy_per_px"], 4),
+            "mtf30_cy_per_mm": _round(read["mtf30_cy_per_mm"], 2),
+            "mtf30_cy_per_px": _round(read["mtf30_cy_per_px"], 4),
+            "mtf10_cy_per_mm": _round(read["mtf10_cy_per_mm"], 2),
+            "mtf10_cy_per_px": _round(read["mtf10_cy_per_px"], 4),
             **({"isp": isp_name or "camera", "esfr": esfr} if tagged else {}),
         })
     if plot is not None:
@@ -153,26 +159,39 @@ def mtf_command(
     if tagged:
         title += f"; ISP {isp_name or 'of each camera'}, e-SFR {esfr}"
     table = Table(title=title)
-    for col in ("name", "pixel µm", "f-number", "measured", "analytic", "paper group", "Nyquist"):
+    for col in ("name", "pixel µm", "f-number", "measured", "analytic", "paper group", "Nyquist", "MTF30", "MTF10"):
         table.add_column(col, justify="right")
     for r in results:
         table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['mtf50_cy_per_mm']:.1f}",
-                      f"{r['mtf50_analytic_cy_per_mm']:.1f}", f"{r['mtf50_group'] or '-'}", f"{r['nyquist_cy_per_mm']:.0f}")
+                      f"{r['mtf50_analytic_cy_per_mm']:.1f}", f"{r['mtf50_group'] or '-'}", f"{r['nyquist_cy_per_mm']:.0f}",
+                      _cell(r["mtf30_cy_per_mm"], ".1f"), _cell(r["mtf10_cy_per_mm"], ".1f"))
     _out.print(table)
+    _out.print("measured = MTF50; MTF30, MTF10 read off the same curve ('-': not reached below 1 cycle/pixel)",
+               highlight=False)
+    for r in results:
+        per_px = ", ".join(f"MTF{n} {_cell(r[f'mtf{n}_cy_per_px'], '.3f')}" for n in (50, 30, 10))
+        _out.print(f"{r['name']} in cycles/pixel (Nyquist 0.5): {per_px}", highlight=False)
 
 
-def _plot(curves: list, path: Path) -> None:
+def _round(value: float, digits: int) -> float | None:
+    """Rounded, or None (JSON null) for NaN: a level the curve does not reach."""
+    return None if value != value else round(float(value), digits)
+
+
+def _cell(value: float | None, fmt: str) -> str:
+    return "-" if value is None else format(value, fmt)
+
+
+def _plot(curves: list[dict], path: Path) -> None:
+    """The curves with Nyquist, MTF50/30/10 and a cycles/pixel axis (:func:`benchmark.mtf.mtf_figure`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for name, freq, mtf in curves:
-        ax.plot(freq, mtf, label=name)
-    ax.axhline(0.5, color="grey", lw=0.8, ls="--")
-    ax.set(xlabel="cycles/mm on the sensor", ylabel="MTF (luminance)", xlim=(0, 500), ylim=(0, 1.1))
-    ax.legend(ncol=2, fontsize=8)
+    from benchmark.mtf import mtf_figure
+
+    fig = mtf_figure(curves)
     try:
         fig.savefig(path, dpi=120, bbox_inches="tight")
     except (OSError, ValueError) as exc:

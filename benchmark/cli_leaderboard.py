@@ -12,6 +12,7 @@ from typing import Annotated, Optional
 import typer
 
 from benchmark.leaderboard.schema import SubmissionError
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 
 
 def _fail(message: str, code: int = 2) -> None:
@@ -28,7 +29,7 @@ def submit(
     check: Annotated[Optional[Path], typer.Option("--check", help="validate this submission file instead of building one")] = None,
     detections: Annotated[Optional[list[Path]], typer.Option(help="with --check: a detections file to recompute AP from (repeatable, matched to a condition by sha256)")] = None,
     groundtruth: Annotated[Optional[Path], typer.Option(help="with --detections: the ground truth on the camera grid (a run's groundtruth.json)")] = None,
-    n_resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples for OD50's SD")] = 1000,
+    n_resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples for OD50's SD")] = BOOTSTRAP_RESAMPLES,
     seed: Annotated[int, typer.Option(min=0, help="bootstrap seed (a sweep's --seed reuses its cached od50.json)")] = 0,
     created_at: Annotated[Optional[str], typer.Option(help="fix the timestamp (YYYY-MM-DDTHH:MM:SSZ); default now, or SOURCE_DATE_EPOCH")] = None,
     mtf: Annotated[bool, typer.Option(help="measure MTF50 on the camera (else the published group)")] = True,
@@ -68,12 +69,22 @@ def submit(
             check_not_duplicate(sub, leaderboard)
         for sub in subs:
             path = write_submission(sub, leaderboard)
-            day = sub["conditions"]["day"]["od50_m"]
+            day = _od50_text(sub["conditions"]["day"])
             skipped = sorted({r.condition for r in groups[sub["camera"]["name"]]} - set(sub["conditions"]))
             note = f"; not ranked, left out: {', '.join(skipped)}" if skipped else ""
-            typer.echo(f"wrote {path} (day OD50 {'inf' if day is None else f'{day:.1f} m'}; conditions {', '.join(sorted(sub['conditions']))}{note})")
+            typer.echo(f"wrote {path} (day OD50 {day}, {n_resamples} bootstrap resamples; conditions {', '.join(sorted(sub['conditions']))}{note})")
     except (SubmissionError, ValueError) as exc:
         _fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+
+
+def _od50_text(cond: dict) -> str:
+    """Day OD50 for the submit line: the bound when censored ("> 200 m"), else "123.4 m"."""
+    from benchmark.leaderboard.render import censoring
+
+    censored, bound, _ = censoring(cond)
+    if censored and bound is not None:
+        return f"{censored} {bound:g} m"
+    return "inf" if cond["od50_m"] is None else f"{cond['od50_m']:.1f} m"
 
 
 def leaderboard_cmd(

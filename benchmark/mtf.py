@@ -297,3 +297,74 @@ def measure_mtf50(
         "freq_cy_per_mm": freq / pixel_mm,
         "mtf": mtf,
     }
+
+
+MTF_LEVELS = (0.5, 0.3, 0.1)  # MTF50, MTF30, MTF10: read off every measured curve
+
+
+def mtf_crossing(freq: np.ndarray, mtf: np.ndarray, level: float) -> float:
+    """First frequency where the MTF falls below ``level`` (linear interpolation), in
+    ``freq``'s unit; NaN where the curve starts below it or never falls that far.
+    ``mtf_crossing(f, m, 0.5)`` is :func:`mtf50`."""
+    freq, mtf = np.asarray(freq, float), np.asarray(mtf, float)
+    below = np.nonzero(mtf < level)[0]
+    if below.size == 0 or below[0] == 0:
+        return float("nan")
+    i = below[0]
+    return float(freq[i - 1] + (mtf[i - 1] - level) * (freq[i] - freq[i - 1]) / (mtf[i - 1] - mtf[i]))
+
+
+def mtf_readings(freq_cy_per_mm: np.ndarray, mtf: np.ndarray, pixel_um: float) -> dict:
+    """MTF50, MTF30 and MTF10 of a curve in cycles/mm and cycles/pixel, and the Nyquist
+    frequency: ``{"mtf10_cy_per_mm": ..., "mtf10_cy_per_px": ..., ..., "nyquist_cy_per_mm": ...}``.
+    A level the curve does not reach within the measured band (up to 1 cycle/pixel) is NaN."""
+    pixel_mm = pixel_um * 1e-3
+    out = {}
+    for level in MTF_LEVELS:
+        f = mtf_crossing(freq_cy_per_mm, mtf, level)
+        out[f"mtf{round(level * 100)}_cy_per_mm"] = f
+        out[f"mtf{round(level * 100)}_cy_per_px"] = f * pixel_mm
+    out["nyquist_cy_per_mm"] = 0.5 / pixel_mm
+    return out
+
+
+def mtf_figure(curves: list[dict]):
+    """A matplotlib figure of measured MTF curves, each ``{"name", "pixel_um",
+    "freq_cy_per_mm", "mtf"}``: MTF against cycles/mm on the sensor, each camera's Nyquist
+    frequency as a dotted line in its colour, its MTF50/30/10 marked on the curve, and a
+    second x axis in cycles/pixel — on top where every camera has the same pixel pitch,
+    else a second panel against cycles/pixel (where all the Nyquist lines are 0.5)."""
+    import matplotlib.pyplot as plt
+
+    pitches = {round(float(c["pixel_um"]), 6) for c in curves}
+    shared = len(pitches) <= 1
+    fig, axes = plt.subplots(1 if shared else 2, 1, figsize=(7, 4.5 if shared else 8), squeeze=False)
+    ax = axes[0, 0]
+    nyquists = [0.5e3 / c["pixel_um"] for c in curves] or [500.0]
+    markers = {0.5: "o", 0.3: "s", 0.1: "^"}
+    for c in curves:
+        freq, mtf, pixel_mm = np.asarray(c["freq_cy_per_mm"]), np.asarray(c["mtf"]), c["pixel_um"] * 1e-3
+        readings = mtf_readings(freq, mtf, c["pixel_um"])
+        for a, scale in ((ax, 1.0), *(() if shared else ((axes[1, 0], pixel_mm),))):
+            (line,) = a.plot(freq * scale, mtf, label=c["name"])
+            a.axvline(0.5 / pixel_mm * scale, color=line.get_color(), lw=0.9, ls=":")
+            for level in MTF_LEVELS:
+                f = readings[f"mtf{round(level * 100)}_cy_per_mm"]
+                if np.isfinite(f):
+                    a.plot([f * scale], [level], markers[level], color=line.get_color(), ms=4)
+    for a in axes[:, 0]:
+        for level in MTF_LEVELS:
+            a.axhline(level, color="grey", lw=0.6, ls="--")
+            a.annotate(f"MTF{round(level * 100)}", (1.0, level), xycoords=("axes fraction", "data"),
+                       xytext=(3, 0), textcoords="offset points", va="center", fontsize=7, color="grey")
+        a.set(ylabel="MTF (luminance)", ylim=(0, 1.1))
+        a.legend(ncol=2, fontsize=8, title="dotted: Nyquist", title_fontsize=7)
+    ax.set(xlabel="cycles/mm on the sensor", xlim=(0, 1.2 * max(nyquists)))
+    if shared:
+        pixel_mm = curves[0]["pixel_um"] * 1e-3 if curves else 1e-3
+        top = ax.secondary_xaxis("top", functions=(lambda f: f * pixel_mm, lambda p: p / pixel_mm))
+        top.set_xlabel("cycles/pixel (Nyquist = 0.5)")
+    else:
+        axes[1, 0].set(xlabel="cycles/pixel (Nyquist = 0.5 for every camera)", xlim=(0, 0.6))
+    fig.tight_layout()
+    return fig

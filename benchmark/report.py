@@ -36,7 +36,10 @@ from benchmark.sweep import (  # noqa: E402
     parse_illuminance_condition,
     run_name,
     run_od50,
+    with_censoring,
 )
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES  # noqa: E402
+from benchmark.scoring.od50 import format_od50  # noqa: E402
 
 GT_COLOUR, DET_COLOUR = (0, 200, 0), (230, 0, 0)
 CAR_CATEGORY_ID = 3
@@ -65,12 +68,14 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
     table = pd.DataFrame([{**ident, **{k: r[k] for k in ("distance_m", "ap", "ap50", "n_images")}}
                           for r in results["per_distance"]], columns=TABLE_COLUMNS)
     try:
-        boot = run_od50(root, n_resamples=200, seed=int(results.get("seed", 0)))
+        boot = run_od50(root, n_resamples=BOOTSTRAP_RESAMPLES, seed=int(results.get("seed", 0)))
     except ValueError:  # one environment: no bootstrap
         boot = {"od50_m": results.get("od50_m"), "sd_m": None, "ci95_m": [None, None]}
     od50 = pd.DataFrame([{**ident, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
                           "ci95_lo_m": _num(boot["ci95_m"][0]), "ci95_hi_m": _num(boot["ci95_m"][1])}])
-    meta = {"collection": results.get("collection", {}), "detector": results.get("detector", {}), "seed": results.get("seed")}
+    od50 = with_censoring(od50, table)
+    meta = {"collection": results.get("collection", {}), "detector": results.get("detector", {}), "seed": results.get("seed"),
+            "n_resamples": boot.get("n_resamples")}
     return table, od50, {(cam["name"], results["condition"]): root}, meta
 
 
@@ -100,14 +105,20 @@ def plot_ap_curves(table: pd.DataFrame, out=None):
 
 
 def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
-    """One row per camera × condition: MTF50, OD50 ± SD, 95 % interval, AP per distance."""
+    """One row per camera × condition: MTF50, OD50 ± SD, 95 % interval, AP per distance.
+
+    A censored OD50 (``censored`` ">" or "<": AP does not cross 0.5 inside the measured
+    distances) shows its bound, "> 200" or "< 25", with no ± and no interval: the number
+    behind it is an extrapolation."""
     ap = table.pivot_table(index=["camera", "condition"], columns="distance_m", values="ap", sort=False)
     ap.columns = [f"AP {d:g} m" for d in ap.columns]
     rows = od50.set_index(["camera", "condition"])
     out = pd.DataFrame({
         "MTF50 (cy/mm)": rows["mtf50_cy_per_mm"].map(lambda v: f"{v:.1f}" if np.isfinite(v) else "–"),
-        "OD50 ± SD (m)": [_pm(o, s) for o, s in zip(rows["od50_m"], rows["sd_m"])],
-        "95 % interval (m)": [_interval(lo, hi) for lo, hi in zip(rows.get("ci95_lo_m", np.nan), rows.get("ci95_hi_m", np.nan))],
+        "OD50 ± SD (m)": [_pm(o, s, c, b) for o, s, c, b in zip(rows["od50_m"], rows["sd_m"], _col(rows, "censored", ""),
+                                                                _col(rows, "bound_m", np.nan))],
+        "95 % interval (m)": [_interval(lo, hi) if not c else "–" for lo, hi, c in zip(
+            rows.get("ci95_lo_m", np.nan), rows.get("ci95_hi_m", np.nan), _col(rows, "censored", ""))],
     }, index=rows.index)
     return out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
 
@@ -222,7 +233,8 @@ def _main_figures(table: pd.DataFrame, od50: pd.DataFrame, fig_dir: Path) -> lis
         measured = (float(table["distance_m"].min()), float(table["distance_m"].max()))
         figures.append(("OD50 vs MTF50", "OD50 with its 95 % bootstrap interval over environments; least-squares "
                         "line per condition through the OD50s inside the measured distances, its slope in the "
-                        "legend; hollow: extrapolated OD50s, not fitted (drawn at the top when beyond it).",
+                        "legend; hollow triangles: OD50 beyond the measured distances, drawn at the bound (▲ \u2018> farthest\u2019: a "
+                        "lower bound; ▼ \u2018< nearest\u2019), not fitted.",
                         spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50", measured_range_m=measured)))
     return figures
 
@@ -279,7 +291,13 @@ def _num(value) -> float:
     return float("nan") if value is None else float(value)
 
 
-def _pm(value: float, sd: float) -> str:
+def _col(rows: pd.DataFrame, name: str, default) -> list:
+    return list(rows[name]) if name in rows.columns else [default] * len(rows)
+
+
+def _pm(value: float, sd: float, censored: str = "", bound_m: float = np.nan) -> str:
+    if censored and np.isfinite(bound_m):
+        return format_od50(value, censored, bound_m, unit="")
     if not np.isfinite(value):
         return "∞" if value == math.inf else "–"
     return f"{value:.1f} ± {sd:.1f}" if np.isfinite(sd) else f"{value:.1f}"

@@ -10,6 +10,10 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
 - ``groundtruth.json``: the collection's ground truth on the camera's grid (scaled, or
   mapped onto the camera's window of the field: :func:`camera_geometry`);
 - ``images/<scene>.png``: the camera's sRGB images (optional).
+
+A run on a :class:`CollectionSubset` (``--environments 0-2,5 --distances 25,50``, a quick
+try) records ``subset`` in results.json; `benchmark submit` refuses it and a sweep never
+reuses it as a full run.
 """
 
 from __future__ import annotations
@@ -92,6 +96,109 @@ def camera_geometry(collection, camera) -> dict | None:
         return None
     return {"hfov_deg": round(camera.hfov_deg, 6), "vfov_deg": round(camera.vfov_deg, 6),
             "window_tan": list(window.as_tuple()), "collection_fov_deg": [round(v, 6) for v in fov_deg(field)]}
+
+
+def _compact(values) -> str:
+    """Sorted integers as ranges: [0, 1, 2, 5] → "0-2, 5"."""
+    values, parts, start = sorted(values), [], None
+    for i, v in enumerate(values):
+        start = v if start is None else start
+        if i + 1 == len(values) or values[i + 1] != v + 1:
+            parts.append(f"{start}" if start == v else f"{start}-{v}")
+            start = None
+    return ", ".join(parts)
+
+
+def _parse_environments(text: str, known: list[int]) -> list[int]:
+    chosen: set[int] = set()
+    for token in (t.strip() for t in str(text).split(",")):
+        try:
+            lo, _, hi = token.partition("-")
+            lo_i, hi_i = int(lo), int(hi) if hi else int(lo)
+        except ValueError:
+            raise ValueError(f"--environments: {token!r} is neither an environment id nor a range "
+                             "(e.g. --environments 0-2,5)") from None
+        if hi_i < lo_i:
+            raise ValueError(f"--environments: empty range {token!r}")
+        chosen.update(range(lo_i, hi_i + 1))
+    unknown = sorted(chosen - set(known))
+    if unknown:
+        raise ValueError(f"--environments: unknown environment id(s) {_compact(unknown)} "
+                         f"(this collection has {_compact(known)})")
+    return sorted(chosen)
+
+
+def _parse_distances(text: str, known: list[float]) -> list[float]:
+    chosen: list[float] = []
+    for token in (t.strip() for t in str(text).split(",")):
+        try:
+            value = float(token.removesuffix("m").strip())
+        except ValueError:
+            raise ValueError(f"--distances: {token!r} is not a distance in metres (e.g. --distances 25,50)") from None
+        match = next((d for d in known if abs(d - value) < 1e-6), None)
+        if match is None:
+            raise ValueError(f"--distances: unknown distance {token} m "
+                             f"(this collection has {', '.join(f'{d:g}' for d in known)} m)")
+        if match not in chosen:
+            chosen.append(match)
+    return sorted(chosen)
+
+
+def parse_subset(collection, environments: str | None = None, distances: str | None = None) -> dict | None:
+    """The scenes a quick try keeps: ``environments`` such as ``"0-2,5"`` (ids and inclusive
+    ranges) and ``distances`` such as ``"25,50"`` (metres), each None for all. Returns
+    ``{"environments": [...], "distances_m": [...]}``, or None where nothing is left out
+    (a "subset" of every scene is the full run). A one-line ValueError names an unknown id
+    or distance and what the collection has."""
+    if environments is None and distances is None:
+        return None
+    scenes = collection.scenes()
+    known_envs = sorted({int(s.environment_id) for s in scenes})
+    known_dists = sorted({float(s.distance_m) for s in scenes})
+    envs = known_envs if environments is None else _parse_environments(environments, known_envs)
+    dists = known_dists if distances is None else _parse_distances(distances, known_dists)
+    if envs == known_envs and dists == known_dists:
+        return None
+    return {"environments": envs, "distances_m": dists}
+
+
+def subset_tag(subset: dict) -> str:
+    """Short, stable name of a subset for run folder names: ``subset-1a2b3c4d``."""
+    return "subset-" + hashlib.sha256(json.dumps(subset, sort_keys=True).encode()).hexdigest()[:8]
+
+
+class CollectionSubset:
+    """A collection seen through a subset of its scenes (:func:`parse_subset`): ``scenes()``
+    and ``groundtruth()`` keep only the chosen environments × distances; everything else is
+    the collection's. Its ``subset`` attribute marks every run made on it (results.json
+    ``subset``, the sweep cache key), so a subset run is never taken for a full one."""
+
+    def __init__(self, collection, subset: dict):
+        self._collection, self.subset = collection, subset
+        self._envs = set(subset["environments"])
+
+    def _keep(self, environment_id, distance_m) -> bool:
+        return int(environment_id) in self._envs and any(abs(float(distance_m) - d) < 1e-6
+                                                         for d in self.subset["distances_m"])
+
+    def __getattr__(self, name):
+        return getattr(self._collection, name)
+
+    def scenes(self):
+        return [s for s in self._collection.scenes() if self._keep(s.environment_id, s.distance_m)]
+
+    def groundtruth(self) -> dict:
+        gt = self._collection.groundtruth()
+        gt["images"] = [im for im in gt["images"] if self._keep(im["environment_id"], im["distance_m"])]
+        ids = {im["id"] for im in gt["images"]}
+        gt["annotations"] = [a for a in gt["annotations"] if a["image_id"] in ids]
+        return gt
+
+
+def subset_collection(collection, environments: str | None = None, distances: str | None = None):
+    """``collection`` itself, or a :class:`CollectionSubset` of it (see :func:`parse_subset`)."""
+    subset = parse_subset(collection, environments, distances)
+    return collection if subset is None else CollectionSubset(collection, subset)
 
 
 @dataclass
@@ -234,6 +341,14 @@ def _run_camera(collection, camera, condition: str, detector, out_dir: Path, sta
     }
     if geometry is not None:  # a camera that sees a window of the field (the registry's keep their bytes)
         results["camera_geometry"] = geometry
+    class_map = getattr(detector, "class_map", None)
+    if class_map is not None:  # a detector with other classes than COCO's 80 (docs/detection.md)
+        from benchmark.detectors.classmap import class_map_names
+
+        results["detector"]["class_map"] = class_map_names(class_map)
+    subset = getattr(collection, "subset", None)
+    if subset:  # a quick try on part of the collection: never a full run (sweep key, `benchmark submit`)
+        results["subset"] = subset
     if short_exposures:  # hdr only (other results keep their bytes); exposure_s holds the long frames
         results["exposure_short_s"] = short_exposures
     (stage / "detections.json").write_bytes(detections_bytes)

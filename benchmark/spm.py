@@ -171,14 +171,22 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     ``measured_range_m`` (nearest, farthest distance, m): OD50s outside it are
     extrapolations (the paper's outlier, Fig. 7A); they are drawn hollow, at the top of
     the axes when they lie above it, and left out of the fit, so that one camera whose AP
-    never falls to 0.5 in the measured range cannot set the slope.
+    never falls to 0.5 in the measured range cannot set the slope. With ``censored`` and
+    ``bound_m`` columns (:func:`benchmark.sweep.with_censoring`, as the report passes) the
+    censored OD50s are drawn as hollow triangles at their bound instead — ▲ at the farthest
+    distance ("> 200 m", a lower bound), ▼ at the nearest ("< 25 m") — and the legend says so.
     """
     _require(od50_table, ("condition", "mtf50_cy_per_mm", "od50_m", "sd_m"))
     conditions = list(conditions) if conditions is not None else list(dict.fromkeys(od50_table["condition"]))
     lo_m, hi_m = measured_range_m if measured_range_m is not None else (-np.inf, np.inf)
     finite = od50_table.assign(od50_m=od50_table["od50_m"].astype(float))
     finite = finite[np.isfinite(finite["od50_m"])]
-    finite = finite.assign(fitted=finite["od50_m"].between(lo_m, hi_m))
+    censored = "censored" in finite.columns and "bound_m" in finite.columns
+    if censored:  # a censored OD50 is a bound, drawn at the bound (not at its extrapolated number), not fitted
+        finite = finite.assign(censored=finite["censored"].fillna("").astype(str))
+        finite = finite.assign(fitted=finite["censored"] == "")
+    else:
+        finite = finite.assign(fitted=finite["od50_m"].between(lo_m, hi_m))
     inside = finite[finite["fitted"]]
     top = max(_axis_top(inside if len(inside) else finite), 1.1 * hi_m if np.isfinite(hi_m) else 0.0)
     fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
@@ -188,8 +196,17 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
         slope, intercept = fit_line(fitted["mtf50_cy_per_mm"], fitted["od50_m"])
         label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}: no fit"
-        if len(outside):
+        if len(outside) and censored:
+            label += f" ({_bounds_text(outside)}: hollow, not fitted)"
+        elif len(outside):
             label += f" ({len(outside)} extrapolated: hollow, not fitted)"
+        if censored and len(outside):
+            for sign, marker in ((">", "^"), ("<", "v")):
+                pts = outside[outside["censored"] == sign]
+                if len(pts):
+                    ax.plot(pts["mtf50_cy_per_mm"], np.minimum(pts["bound_m"].astype(float), top), marker, ms=8,
+                            mfc="none", color=colour, alpha=0.9, ls="none")
+            outside = outside.iloc[0:0]
         # filled (and labelled) even when empty, so every condition has its legend entry
         for points, style in ((fitted, {"label": label}), (outside, {"mfc": "none", "alpha": 0.8})):
             if len(points) or "label" in style:
@@ -206,6 +223,16 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     if out is not None:
         save_figure(fig, out)
     return fig
+
+
+def _bounds_text(points: pd.DataFrame) -> str:
+    """"2 OD50 > 200 m (▲, lower bounds), 1 < 25 m (▼)" of the censored points."""
+    parts = []
+    for sign, arrow, what in ((">", "▲", "lower bound"), ("<", "▼", "upper bound")):
+        pts = points[points["censored"] == sign]
+        if len(pts):
+            parts.append(f"{len(pts)} OD50 {sign} {pts['bound_m'].astype(float).iloc[0]:g} m ({arrow}, {what}{'s' if len(pts) > 1 else ''})")
+    return ", ".join(parts)
 
 
 def _axis_top(table: pd.DataFrame) -> float:

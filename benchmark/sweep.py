@@ -6,6 +6,8 @@ Each (camera, condition) pair is one :func:`benchmark.run.run_camera` call in
 of several policies share one folder without overwriting). Runs are cached: a run folder whose
 ``results.json`` carries the same key — camera spec sha256, condition, detector sha256
 and input size, collection manifest sha256, seed — is reused, not recomputed.
+A collection subset (:class:`benchmark.run.CollectionSubset`, ``--environments`` /
+``--distances``) adds ``subset`` to the key and ``+subset-<hash>`` to the folder name.
 ``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
 only its missing (or stale) runs.
 
@@ -35,6 +37,9 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.scoring.od50 import od50_censoring
+
 if TYPE_CHECKING:
     from benchmark.cameras.spec import ExposureSpec
 
@@ -43,7 +48,9 @@ MTF_SOURCES = ("measured", "analytic", "published")
 TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
                  "distance_m", "ap", "ap50", "n_images"]
 OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
-                "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite"]
+                "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite", "censored"]
+# censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
+# extrapolation, report "> farthest m") or "<" (below 0.5 already at the nearest); see benchmark.scoring.od50
 
 _ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")
 
@@ -75,6 +82,13 @@ def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
     geometry = camera_geometry(collection, camera)
     if geometry is not None:
         key["camera_geometry"] = geometry
+    subset = getattr(collection, "subset", None)
+    if subset:  # a subset run (--environments/--distances) is never reused as a full one, nor the reverse
+        key["subset"] = subset
+    if getattr(detector, "class_map", None) is not None:  # the same model file read through another class map
+        from benchmark.detectors.classmap import class_map_names
+
+        key["class_map"] = class_map_names(detector.class_map)
     return key
 
 
@@ -85,6 +99,10 @@ def results_key(results: dict) -> dict:
            "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
     if "camera_geometry" in results:
         key["camera_geometry"] = results["camera_geometry"]
+    if "subset" in results:
+        key["subset"] = results["subset"]
+    if "class_map" in results["detector"]:
+        key["class_map"] = results["detector"]["class_map"]
     return key
 
 
@@ -154,7 +172,7 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
 
 
 def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
-          n_resamples: int = 1000, progress: Progress | None = None, mtf_source: str = "measured",
+          n_resamples: int = BOOTSTRAP_RESAMPLES, progress: Progress | None = None, mtf_source: str = "measured",
           backend: str = "faster-coco-eval", save_images: bool = True,
           exposure: ExposureSpec | None = None) -> pd.DataFrame:
     """Run every camera × condition (reusing cached runs); write and return the AP table.
@@ -192,6 +210,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     # A run folder is tagged only where the policy changed the camera: cam01-day always
     # holds the camera's own spec, and `--exposure auto_peak` reuses the reference runs.
     tags = {c.name: exposure_tag(exposure) if c.exposure != o.exposure else None for c, o in zip(cameras, own)}
+    subset = getattr(collection, "subset", None)
+    # A subset's runs live in their own folders (cam01-day+subset-1a2b3c4d): a quick try never overwrites a full run.
+    suffix = f"+{run_module.subset_tag(subset)}" if subset else ""
     conditions = list(conditions)
     if not cameras or not conditions:
         raise ValueError("sweep needs at least one camera and one condition")
@@ -219,7 +240,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                  "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
         for condition in conditions:
             label = f"{camera.name} · {condition}"
-            run_dir = out_dir / "runs" / run_name(camera.name, condition, tags[camera.name])
+            run_dir = out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
             results = cached_results(run_dir, run_key(camera, condition, detector, collection, seed))
             reused = results is not None
             if results is None:
@@ -240,7 +261,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             lo, hi = boot["ci95_m"]
             od50_rows.append({**ident, "condition": condition, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
                               "ci95_lo_m": _num(lo), "ci95_hi_m": _num(hi), "n_resamples": boot["n_resamples"],
-                              "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"]})
+                              "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"],
+                              "censored": od50_censoring([r["distance_m"] for r in results["per_distance"]],
+                                                         [r["ap"] for r in results["per_distance"]])[0]})
 
     table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
     od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
@@ -255,6 +278,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         "table": _json_safe(table.to_dict(orient="records")),
         "od50": _json_safe(od50_table.to_dict(orient="records")),
     }
+    if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
+        meta["subset"] = subset
     if exposure is not None:  # only then, so that other sweeps keep their bytes
         meta["exposure"] = {"policy": format_exposure(exposure), "tag": exposure_tag(exposure),
                             "spec": exposure.model_dump(mode="json")}
@@ -282,11 +307,38 @@ def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
 def load_sweep(out_dir) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(AP table, OD50 table) of a sweep folder."""
     out_dir = Path(out_dir)
-    return pd.read_csv(out_dir / "sweep.csv"), pd.read_csv(out_dir / "od50.csv")
+    table = pd.read_csv(out_dir / "sweep.csv")
+    return table, with_censoring(pd.read_csv(out_dir / "od50.csv"), table)
+
+
+def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
+    """``od50`` with ``censored`` ("", ">", "<") and ``bound_m`` (the farthest or nearest measured
+    distance where censored, else NaN) derived from the AP table's per-distance AP, so that
+    sweeps written before the ``censored`` column show their bounds too."""
+    od50 = od50.copy()
+    censored, bounds = [], []
+    groups = {key: part for key, part in table.groupby(["camera", "condition"], sort=False)}
+    for cam, cond in od50[["camera", "condition"]].itertuples(index=False):
+        part = groups.get((cam, cond))
+        c, bound = ("", None) if part is None or len(part) < 2 else od50_censoring(part["distance_m"], part["ap"])
+        censored.append(c)
+        bounds.append(float("nan") if bound is None else bound)
+    od50["censored"], od50["bound_m"] = censored, bounds
+    return od50
 
 
 def _num(value) -> float:
     return float("nan") if value is None else float(value)
+
+
+def od50_cell(row) -> str:
+    """One od50.csv row for people: "123.4 ± 5.6", "> 200" or "< 25" (censored: a bound), "∞"."""
+    from benchmark.scoring.od50 import format_od50
+
+    censored = str(row.get("censored", "") or "")
+    bound = row.get("bound_m")
+    bound = None if bound is None or bound != bound else float(bound)
+    return format_od50(row["od50_m"], censored, bound, row.get("sd_m"), unit="")
 
 
 def _json_safe(value):

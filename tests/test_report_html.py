@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from benchmark import report as report_module
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from test_sweep_cache import make_fake_sweep  # the fake runs (tests/ is on sys.path)
 
 DATA_PNG = re.compile(r"src='data:image/png;base64,([A-Za-z0-9+/=]+)'")
@@ -122,4 +123,5 @@ def test_load_results_of_a_run_folder(sweep_dir):
     table, od50, runs, meta = report_module.load_results(sweep_dir / "runs" / "cam05-night")
     assert len(table) == 6 and set(table.condition) == {"night"}
     assert list(runs) == [("cam05", "night")]
-    assert json.loads((sweep_dir / "runs" / "cam05-night" / "od50.json").read_text())["key"]["n_resamples"] == 200
+    assert json.loads((sweep_dir / "runs" / "cam05-night" / "od50.json").read_text())["key"]["n_resamples"] == BOOTSTRAP_RESAMPLES  # one default everywhere
+    assert meta["n_resamples"] == BOOTSTRAP_RESAMPLES  # printed with the result (the page's facts)

@@ -75,27 +75,30 @@ def check_finite(output: np.ndarray, path: Path, what: str) -> None:
                             "infinite); the model file is broken")
 
 
-def infer_family(session: ort.InferenceSession, path: Path) -> str:
-    """Family from the output shape: [., 84, N] YOLOv8; [., N, 85] YOLOv5 (N = 3·cells) or YOLOX (N = cells)."""
+def infer_family(session: ort.InferenceSession, path: Path, n_classes: int = N_CLASSES) -> str:
+    """Family from the output shape: [., 84, N] YOLOv8; [., N, 85] YOLOv5 (N = 3·cells) or YOLOX (N = cells)
+    (4 + ``n_classes`` and 5 + ``n_classes`` for a model with a class map)."""
     hw, shape = _output_layout(session, path)
     cells = grid_cells(*hw)
-    if len(shape) == 3 and shape[1] == 4 + N_CLASSES and shape[2] == cells:
+    if len(shape) == 3 and shape[1] == 4 + n_classes and shape[2] == cells:
         return "yolov8"
-    if len(shape) == 3 and shape[2] == 5 + N_CLASSES:
+    if len(shape) == 3 and shape[2] == 5 + n_classes:
         if shape[1] == 3 * cells:
             return "yolov5"
         if shape[1] == cells:
             return "yolox"
     raise DetectorError(
         f"wrong output shape {list(shape)} for a {hw[0]}x{hw[1]} input in {path}: expected "
-        f"[b,{3 * cells},85] (YOLOv5), [b,{cells},85] (YOLOX) or [b,84,{cells}] (YOLOv8), 80 COCO classes"
+        f"[b,{3 * cells},{5 + n_classes}] (YOLOv5), [b,{cells},{5 + n_classes}] (YOLOX) or [b,{4 + n_classes},{cells}] "
+        f"(YOLOv8), {n_classes} classes" + (" (a model with other classes needs a class map: --class-map car, "
+                                              "docs/detection.md)" if n_classes == N_CLASSES else " (the class map's)")
     )
 
 
-def check_family(session: ort.InferenceSession, path: Path, family: Family) -> None:
+def check_family(session: ort.InferenceSession, path: Path, family: Family, n_classes: int = N_CLASSES) -> None:
     hw, shape = _output_layout(session, path)
     rows = family.expected_rows(hw)
-    want = (rows, 5 + N_CLASSES) if family.channels_last_output else (4 + N_CLASSES, rows)
+    want = (rows, 5 + n_classes) if family.channels_last_output else (4 + n_classes, rows)
     if len(shape) != 3 or tuple(shape[1:]) != want:
         raise DetectorError(f"wrong output shape {list(shape)} for a {family.name} model in {path}: expected [b,{want[0]},{want[1]}]")
 
@@ -103,8 +106,11 @@ def check_family(session: ort.InferenceSession, path: Path, family: Family) -> N
 class OnnxDetector:
     """A YOLO-family ONNX model with an input-size policy (see :func:`load_detector`)."""
 
-    def __init__(self, session: ort.InferenceSession, *, path: Path, name: str, family: str, sha256: str, input_size: str | int):
+    def __init__(self, session: ort.InferenceSession, *, path: Path, name: str, family: str, sha256: str, input_size: str | int,
+                 class_map: tuple[int, ...] | None = None):
         self.session = session
+        self.class_map = class_map  # COCO-80 index per model class (-1: dropped); None: an 80-class COCO model
+        self._class_lut = None if class_map is None else np.asarray(class_map, dtype=np.int64)
         self.path = Path(path)
         self.name = name
         self.family = family
@@ -146,6 +152,9 @@ class OnnxDetector:
         for hw, idx in groups.items():
             for i, out in zip(idx, self._run([placed[i][0] for i in idx])):
                 boxes, scores, cls = self._family.decode(out, hw, conf, multi_label)
+                if self._class_lut is not None:  # model classes -> COCO classes, dropped ones removed
+                    cls = self._class_lut[cls]
+                    boxes, scores, cls = boxes[cls >= 0], scores[cls >= 0], cls[cls >= 0]
                 if self._family.max_candidates and len(scores) > self._family.max_candidates:
                     top = np.argsort(-scores, kind="stable")[: self._family.max_candidates]
                     boxes, scores, cls = boxes[top], scores[top], cls[top]

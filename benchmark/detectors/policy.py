@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from benchmark.detectors.base import DetectorError
 
 MULTISCALE_FIXED_PX = 640
+# The command lines' one default (`benchmark run`, `sweep` and `detect`): the reference policy.
+DEFAULT_INPUT_SIZE = "multiscale"
 STRIDE = 32
 
 

@@ -20,12 +20,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from benchmark.leaderboard.files import atomic_write_text, sha256_file
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
 from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
 
 RESULTS_FORMAT = "metricscenes-results/1"
-N_RESAMPLES = 1000
+N_RESAMPLES = BOOTSTRAP_RESAMPLES  # the one default (benchmark.scoring.bootstrap)
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,7 @@ def find_runs(results_dir: str | Path) -> list[Run]:
             raise SubmissionError(f"{folder / 'results.json'}: cannot read ({type(exc).__name__})") from None
         if not isinstance(results, dict) or results.get("format") != RESULTS_FORMAT:
             raise SubmissionError(f"{folder / 'results.json'}: not a {RESULTS_FORMAT} file")
+        if results.get("subset"): raise SubmissionError(f"{folder}: a subset run (--environments/--distances) cannot be submitted; submit a run of the whole collection")  # noqa: E701
         runs.append(Run(folder, results))
     return runs
 

@@ -29,10 +29,11 @@ import numpy as np
 from scipy import stats
 
 from benchmark.scoring.ap import ALL_AREAS, MAX_DETS, ap_by_distance, images_by_distance
-from benchmark.scoring.od50 import od50
+from benchmark.scoring.od50 import od50, od50_censoring
 
 REC_THRS = np.linspace(0.0, 1.00, 101)  # COCO recall thresholds
 IOU_THRS = np.linspace(0.5, 0.95, 10)
+BOOTSTRAP_RESAMPLES = 1000  # the one default: run report, sweep, leaderboard and compare (printed with results)
 
 
 def resample_environments(groundtruth: dict, detections: list[dict], environments) -> tuple[dict, list[dict]]:
@@ -155,7 +156,7 @@ def bootstrap_od50(
     groundtruth: dict,
     detections: list[dict],
     *,
-    n_resamples: int = 1000,
+    n_resamples: int = BOOTSTRAP_RESAMPLES,
     seed: int = 0,
     backend: str = "faster-coco-eval",
     category_id: int = 3,
@@ -163,7 +164,8 @@ def bootstrap_od50(
 ) -> dict:
     """OD50 (from the full set, ``backend``) with its bootstrap SD and percentile CI over environments.
 
-    Returns ``{od50_m, sd_m, ci95_m: (lo, hi), n_resamples, n_environments, n_infinite}``;
+    Returns ``{od50_m, sd_m, ci95_m: (lo, hi), n_resamples, n_environments, n_infinite,
+    censored, bound_m}`` (``censored``: "", ">" or "<" of the full set, :func:`od50_censoring`);
     ``sd_m`` is the SD (ddof 1) of the finite resampled OD50s, ``n_infinite`` counts
     resamples whose AP never falls to 0.5 (OD50 = inf; they still enter the CI).
     """
@@ -175,6 +177,7 @@ def bootstrap_od50(
     env_index = {e: k for k, e in enumerate(envs)}
     rows = ap_by_distance(groundtruth, detections, backend=backend, category_id=category_id)
     point = od50([r["distance_m"] for r in rows], [r["ap"] for r in rows])
+    censored, bound_m = od50_censoring([r["distance_m"] for r in rows], [r["ap"] for r in rows])
     tables = _match_tables(groundtruth, detections, category_id, env_index)
     distances = list(tables)
 
@@ -201,6 +204,8 @@ def bootstrap_od50(
         "n_resamples": int(n_resamples),
         "n_environments": len(envs),
         "n_infinite": int(dist.size - finite.size),
+        "censored": censored,
+        "bound_m": bound_m,
     }
 
 

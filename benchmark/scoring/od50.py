@@ -19,6 +19,12 @@ Rules, applied to the points sorted by distance (NaN AP points dropped; at least
 Rule 1 with rules 2-3 (plain linear extrapolation from the nearest two points)
 reproduces the paper's values; the flat/rising cases are our additions so that OD50 is
 always defined (inf or a number >= 0, never NaN) for bootstrapping.
+
+**Censoring.** Rules 2 and 3 are extrapolations, kept only so that the bootstrap has a
+number; they are not reported. :func:`od50_censoring` tells them apart, and tables, reports,
+figures and the leaderboard show the bound instead: "> 200 m" (AP has not fallen to 0.5 at
+the farthest measured distance: a lower bound) or "< 25 m" (AP is below 0.5 already at the
+nearest: an upper bound). See :func:`format_od50`.
 """
 
 from __future__ import annotations
@@ -58,3 +64,44 @@ def od50(distances_m, ap, *, level: float = AP_LEVEL) -> float:
     if a[1] >= a[0]:
         return 0.0
     return float(max(0.0, _line_at(d[0], a[0], d[1], a[1], level)))
+
+
+# --- censoring: OD50 outside the measured distances is a bound, not a number -------------------
+
+CENSORED_ABOVE, CENSORED_BELOW, NOT_CENSORED = ">", "<", ""
+
+
+def od50_censoring(distances_m, ap, *, level: float = AP_LEVEL) -> tuple[str, float | None]:
+    """(``censored``, ``bound_m``) of the OD50 of these points (NaN AP points dropped).
+
+    ``">"``, farthest distance: AP has not fallen to ``level`` within the measured distances
+    (no downward crossing and the farthest point is at or above it; rule 2 above); the OD50 is
+    a lower bound, reported as "> 200 m", never as the extrapolated number.
+    ``"<"``, nearest distance: AP is below ``level`` at every measured distance (rule 3): an
+    upper bound, "< 25 m". ``""`` and None: a crossing was measured (rule 1).
+    """
+    d = np.asarray(distances_m, dtype=np.float64).ravel()
+    a = np.asarray(ap, dtype=np.float64).ravel()
+    ok = np.isfinite(a) & np.isfinite(d)
+    d, a = d[ok], a[ok]
+    if d.size < 2:
+        raise ValueError(f"od50 needs AP at two or more distances, got {d.size} finite points")
+    order = np.argsort(d, kind="stable")
+    d, a = d[order], a[order]
+    if np.any((a[:-1] >= level) & (a[1:] < level)):
+        return NOT_CENSORED, None
+    if a[-1] >= level:
+        return CENSORED_ABOVE, float(d[-1])
+    return CENSORED_BELOW, float(d[0])
+
+
+def format_od50(od50_m, censored: str = "", bound_m: float | None = None, sd_m=None, *, unit: str = " m") -> str:
+    """OD50 for people: "123.4 ± 5.6 m", or the bound when censored ("> 200 m", "< 25 m", no ±)."""
+    if censored in (CENSORED_ABOVE, CENSORED_BELOW) and bound_m is not None and np.isfinite(bound_m):
+        return f"{censored} {bound_m:g}{unit}"
+    if od50_m is None or not np.isfinite(float(od50_m)):
+        return "–" if od50_m is None or np.isnan(float(od50_m)) else "∞"
+    text = f"{float(od50_m):.1f}"
+    if sd_m is not None and np.isfinite(float(sd_m)):
+        text += f" ± {float(sd_m):.1f}"
+    return text + unit

@@ -1,0 +1,340 @@
+"""``benchmark compare A B``: is camera A's detection range different from camera B's?
+
+A and B are run folders (``results.json``, ``detections.json``, ``groundtruth.json``) or
+sweep folders with ``--camera`` (and ``--condition``). Both must come from the same
+collection (manifest sha256) and hold the same environments and distances; otherwise the
+comparison is refused, since a difference would mix camera and scenes.
+
+**Paired bootstrap.** Environments are resampled with replacement *once* per resample and
+the same draw is applied to A and B (the design of :func:`benchmark.scoring.bootstrap_od50`:
+an environment keeps all its distances). Scenes that are hard for both cameras then move
+both curves together and cancel in the difference, so the interval of ΔAP(d) = AP_A − AP_B
+and ΔOD50 = OD50_A − OD50_B is narrower than one from two independent bootstraps
+(``paired=False``, kept for comparison and tests). AP per distance of the full sets comes
+from :func:`benchmark.scoring.ap_by_distance` (faster-coco-eval); the resamples re-weight
+COCO's per-image matches (:func:`benchmark.scoring.bootstrap.weighted_ap`). Intervals are
+95 % percentile intervals; ± is the bootstrap SD.
+
+**Censoring.** When A's or B's OD50 is censored (AP does not cross 0.5 inside the measured
+distances: "> 200 m" or "< 25 m"), ΔOD50 in metres is not measured: the verdict says so and
+the ΔAP per distance carries the comparison.
+"""
+
+from __future__ import annotations
+
+import json
+import textwrap
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Optional
+
+import numpy as np
+import typer
+
+from benchmark.scoring import ap_by_distance, format_od50, od50, od50_censoring
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
+
+COMPARE_FORMAT = "metricscenes-compare/1"
+CONDITION_WORDS = {"day": "by day", "night": "at night", "dusk": "at dusk"}
+
+
+class CompareError(ValueError):
+    """The two runs cannot be compared (different collections or environments, not a run)."""
+
+
+@dataclass
+class Side:
+    """One side of a comparison: a run folder's results, ground truth and detections."""
+
+    folder: Path
+    results: dict
+    groundtruth: dict
+    detections: list
+
+    @property
+    def camera(self) -> str:
+        return str(self.results.get("camera", {}).get("name", self.folder.name))
+
+    @property
+    def condition(self) -> str:
+        return str(self.results.get("condition", ""))
+
+    @property
+    def manifest_sha256(self) -> str | None:
+        return self.results.get("collection", {}).get("manifest_sha256")
+
+    @property
+    def environments(self) -> set:
+        return {im["environment_id"] for im in self.groundtruth["images"]}
+
+    @property
+    def scenes(self) -> set:
+        return {(im["environment_id"], float(im["distance_m"])) for im in self.groundtruth["images"]}
+
+
+def resolve_run(path: str | Path, camera: str | None = None, condition: str = "day") -> Path:
+    """The run folder of ``path``: itself if it holds results.json, else a sweep folder's run
+    of ``camera`` × ``condition`` (from sweep.json's run list, or ``runs/<camera>-<condition>``)."""
+    path = Path(path)
+    if (path / "results.json").is_file():
+        return path
+    if not path.is_dir():
+        raise CompareError(f"{path}: no such folder")
+    if camera is None:
+        raise CompareError(f"{path} is not a run folder (no results.json); for a sweep folder name the camera with --camera")
+    meta_path = path / "sweep.json"
+    if meta_path.is_file():
+        meta = json.loads(meta_path.read_text())
+        for run in meta.get("runs", []):
+            if run.get("camera") == camera and run.get("condition") == condition:
+                return path / run["path"]
+    candidate = path / "runs" / f"{camera}-{condition}"
+    if (candidate / "results.json").is_file():
+        return candidate
+    raise CompareError(f"{path}: no run of camera {camera!r} in condition {condition!r}")
+
+
+def load_side(folder: str | Path) -> Side:
+    folder = Path(folder)
+    try:
+        return Side(folder, json.loads((folder / "results.json").read_text()),
+                    json.loads((folder / "groundtruth.json").read_text()),
+                    json.loads((folder / "detections.json").read_text()))
+    except FileNotFoundError as exc:
+        raise CompareError(f"{folder}: not a run folder ({Path(exc.filename).name} is missing)") from None
+    except json.JSONDecodeError as exc:
+        raise CompareError(f"{folder}: unreadable JSON ({exc})") from None
+
+
+def check_comparable(a: Side, b: Side) -> None:
+    """Raise :class:`CompareError` (one line) unless A and B share collection and scenes."""
+    if not a.manifest_sha256 or a.manifest_sha256 != b.manifest_sha256:
+        raise CompareError(f"cannot compare: {a.folder} and {b.folder} come from different collections "
+                           f"(manifest sha256 {str(a.manifest_sha256)[:12]} vs {str(b.manifest_sha256)[:12]})")
+    if a.environments != b.environments:
+        raise CompareError(f"cannot compare: {a.folder} and {b.folder} hold different environments "
+                           f"({len(a.environments)} vs {len(b.environments)}, {len(a.environments & b.environments)} shared)")
+    if a.scenes != b.scenes:
+        raise CompareError(f"cannot compare: {a.folder} and {b.folder} hold different scenes (environment × distance)")
+
+
+def _label(side: Side, other: Side) -> str:
+    if side.camera != other.camera:
+        return side.camera
+    if side.condition != other.condition:
+        return f"{side.camera} ({side.condition})"
+    return f"{side.camera} ({side.folder.name})" if side.folder.name != other.folder.name else str(side.folder)
+
+
+def compare_runs(
+    a: Side,
+    b: Side,
+    *,
+    n_resamples: int = BOOTSTRAP_RESAMPLES,
+    seed: int = 0,
+    confidence_level: float = 0.95,
+    paired: bool = True,
+    category_id: int = 3,
+) -> dict:
+    """Paired bootstrap of ΔAP per distance and ΔOD50 (A − B); see the module docstring.
+
+    Returns a JSON-able dict: labels, per-distance AP of each and ΔAP with SD and interval,
+    OD50 of each (with censoring), ΔOD50 with SD and interval (None when censored), the
+    verdict line, and the bootstrap settings.
+    """
+    check_comparable(a, b)
+    if n_resamples < 2:
+        raise ValueError(f"n_resamples must be >= 2, got {n_resamples}")
+    envs = sorted(a.environments, key=str)
+    if len(envs) < 2:
+        raise CompareError(f"cannot compare: a bootstrap needs two or more environments, got {len(envs)}")
+    env_index = {e: k for k, e in enumerate(envs)}
+    backend = a.results.get("scoring_backend", "faster-coco-eval")
+    sides = {}
+    for key, side in (("a", a), ("b", b)):
+        rows = ap_by_distance(side.groundtruth, side.detections, backend=backend, category_id=category_id)
+        dist = [r["distance_m"] for r in rows]
+        ap = [r["ap"] for r in rows]
+        censored, bound = od50_censoring(dist, ap)
+        sides[key] = {"rows": rows, "distances": dist, "ap": np.asarray(ap, dtype=float), "od50_m": od50(dist, ap),
+                      "censored": censored, "bound_m": bound,
+                      "tables": _match_tables(side.groundtruth, side.detections, category_id, env_index)}
+    distances = sides["a"]["distances"]
+    rng = np.random.default_rng(seed)
+    n = len(envs)
+    d_ap = np.empty((n_resamples, len(distances)))
+    d_od = np.empty(n_resamples)
+    for k in range(n_resamples):
+        draw_a = rng.integers(0, n, n)
+        draw_b = draw_a if paired else rng.integers(0, n, n)
+        ap_ab = []
+        for key, draw in (("a", draw_a), ("b", draw_b)):
+            w = np.bincount(draw, minlength=n)
+            ap_ab.append(np.array([weighted_ap(sides[key]["tables"][d], w)[0] for d in distances]))
+        d_ap[k] = ap_ab[0] - ap_ab[1]
+        with np.errstate(invalid="ignore"):
+            d_od[k] = od50(distances, ap_ab[0]) - od50(distances, ap_ab[1])
+    per_distance = []
+    for j, dm in enumerate(distances):
+        col = d_ap[:, j][np.isfinite(d_ap[:, j])]
+        lo, hi = percentile_interval(col, confidence_level)
+        delta = float(sides["a"]["ap"][j] - sides["b"]["ap"][j])
+        per_distance.append({"distance_m": float(dm), "ap_a": float(sides["a"]["ap"][j]), "ap_b": float(sides["b"]["ap"][j]),
+                             "delta_ap": delta, "sd": float(np.std(col, ddof=1)) if col.size > 1 else None,
+                             "ci95": [lo, hi]})
+    censored = bool(sides["a"]["censored"] or sides["b"]["censored"])
+    finite = d_od[np.isfinite(d_od)]
+    delta_od = float(sides["a"]["od50_m"] - sides["b"]["od50_m"])
+    if censored:
+        od_block = {"delta_m": None, "sd_m": None, "ci95_m": [None, None]}
+    else:
+        lo, hi = percentile_interval(d_od[~np.isnan(d_od)], confidence_level)
+        od_block = {"delta_m": delta_od, "sd_m": float(np.std(finite, ddof=1)) if finite.size > 1 else None,
+                    "ci95_m": [lo, hi]}
+    out = {
+        "format": COMPARE_FORMAT,
+        "a": {"label": _label(a, b), "folder": str(a.folder), "camera": a.camera, "condition": a.condition,
+              "od50_m": _finite(sides["a"]["od50_m"]), "censored": sides["a"]["censored"], "bound_m": sides["a"]["bound_m"]},
+        "b": {"label": _label(b, a), "folder": str(b.folder), "camera": b.camera, "condition": b.condition,
+              "od50_m": _finite(sides["b"]["od50_m"]), "censored": sides["b"]["censored"], "bound_m": sides["b"]["bound_m"]},
+        "collection_manifest_sha256": a.manifest_sha256,
+        "n_environments": n,
+        "n_resamples": int(n_resamples),
+        "seed": int(seed),
+        "confidence_level": confidence_level,
+        "paired": paired,
+        "per_distance": per_distance,
+        "delta_od50": od_block,
+    }
+    out["verdict"] = verdict(out)
+    return out
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def _when(cond_a: str, cond_b: str) -> tuple[str, str]:
+    if cond_a == cond_b:
+        return CONDITION_WORDS.get(cond_a, f"in {cond_a}" if cond_a else ""), ""
+    return "", f" ({cond_a} vs {cond_b})"
+
+
+def verdict(result: dict) -> str:
+    """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)"."""
+    a, b, od = result["a"], result["b"], result["delta_od50"]
+    when, suffix = _when(a["condition"], b["condition"])
+    when = f" {when}" if when else ""
+    pct = f"{100 * result['confidence_level']:g} %"
+    if od["delta_m"] is None:
+        resolved = [r for r in result["per_distance"] if r["ci95"][0] > 0 or r["ci95"][1] < 0]
+        od_a = format_od50(a["od50_m"], a["censored"], a["bound_m"])
+        od_b = format_od50(b["od50_m"], b["censored"], b["bound_m"])
+        where = ", ".join(format(r["distance_m"], "g") for r in resolved)
+        tail = (f"AP differs at {where} m"
+                if resolved else "no AP difference resolved at any distance")
+        for first, second in ((a, b), (b, a)):  # a lower bound beats a measured value below it
+            if first["censored"] == ">" and not second["censored"] and second["od50_m"] is not None:
+                gap = first["bound_m"] - second["od50_m"]
+                return (f"{first['label']} detects cars farther than {second['label']}{when}{suffix}, by at least "
+                        f"{gap:.0f} m (OD50 {format_od50(None, '>', first['bound_m'])} vs {second['od50_m']:.1f} m; "
+                        f"a bound, not a measured difference); {tail} ({pct})")
+        return (f"OD50 of {a['label']} is {od_a} and of {b['label']} {od_b}{when}{suffix}: outside the measured distances, "
+                f"ΔOD50 is not measured; {tail} ({pct})")
+    d, sd, (lo, hi) = od["delta_m"], od["sd_m"] or 0.0, od["ci95_m"]
+    if not (lo > 0 or hi < 0):
+        return (f"no difference resolved between {a['label']} and {b['label']}{when}{suffix}: "
+                f"ΔOD50 = {d:+.0f} ± {sd:.0f} m ({pct}: {lo:.0f} to {hi:.0f} m)")
+    word, first, second = ("farther", a, b) if d > 0 else ("farther", b, a)
+    if d < 0:
+        lo, hi = -hi, -lo
+    return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{when}{suffix} "
+            f"({pct}: {lo:.0f}–{hi:.0f} m)")
+
+
+def plot_compare(result: dict, out: str | Path) -> Path:
+    """AP vs distance of both (left) and ΔAP per distance with its interval (right), as PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    rows = result["per_distance"]
+    d = np.array([r["distance_m"] for r in rows])
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    ax1.plot(d, [r["ap_a"] for r in rows], "o-", label=result["a"]["label"])
+    ax1.plot(d, [r["ap_b"] for r in rows], "s--", label=result["b"]["label"])
+    ax1.axhline(0.5, color="grey", lw=0.8, ls=":")
+    ax1.set(xlabel="distance (m)", ylabel="AP", title="AP per distance", ylim=(0, 1))
+    ax1.legend()
+    delta = np.array([r["delta_ap"] for r in rows])
+    lo = np.array([r["ci95"][0] for r in rows], dtype=float)
+    hi = np.array([r["ci95"][1] for r in rows], dtype=float)
+    yerr = np.nan_to_num(np.stack([np.maximum(delta - lo, 0), np.maximum(hi - delta, 0)]))
+    ax2.errorbar(d, delta, yerr=yerr, fmt="o", capsize=4)
+    ax2.axhline(0.0, color="grey", lw=0.8)
+    pct = f"{100 * result['confidence_level']:g} %"
+    ax2.set(xlabel="distance (m)", ylabel=f"ΔAP ({result['a']['label']} − {result['b']['label']})",
+            title=f"ΔAP, paired bootstrap over {result['n_environments']} environments ({pct}, "
+                  f"{result['n_resamples']} resamples)")
+    ax2.title.set_fontsize(9)
+    fig.suptitle(textwrap.fill(result["verdict"], 150), fontsize=9)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def compare_paths(path_a, path_b, *, cameras=(), condition: str = "day", **kwargs) -> dict:
+    """Resolve A and B (run or sweep folders; ``cameras``: none, one for both, or one each) and compare."""
+    cameras = list(cameras)
+    if len(cameras) > 2:
+        raise CompareError(f"--camera: give one (both sides) or two (A then B), got {len(cameras)}")
+    cam_a = cameras[0] if cameras else None
+    cam_b = cameras[-1] if cameras else None
+    return compare_runs(load_side(resolve_run(path_a, cam_a, condition)),
+                        load_side(resolve_run(path_b, cam_b, condition)), **kwargs)
+
+
+def register(app) -> None:
+    """Add ``benchmark compare`` to a Typer app."""
+    from rich.console import Console
+    from rich.table import Table
+
+    @app.command()
+    def compare(
+        a: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
+        b: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
+        camera: Annotated[Optional[list[str]], typer.Option(
+            help="camera in a sweep folder: once for both sides, twice for A then B")] = None,
+        condition: Annotated[str, typer.Option(help="condition of the runs in sweep folders")] = "day",
+        out: Annotated[Optional[Path], typer.Option("--out", "-o", help="folder for compare.json and compare.png")] = None,
+        resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples over environments")] = BOOTSTRAP_RESAMPLES,
+        seed: Annotated[int, typer.Option(help="bootstrap seed")] = 0,
+    ) -> None:
+        """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict."""
+        console, err = Console(), Console(stderr=True)
+        try:
+            with err.status("paired bootstrap"):
+                result = compare_paths(a, b, cameras=camera or (), condition=condition, n_resamples=resamples, seed=seed)
+        except (CompareError, ValueError, OSError) as exc:
+            err.print(f"[bold red]error:[/] {str(exc).splitlines()[0]}", highlight=False, soft_wrap=True)
+            raise typer.Exit(2) from None
+        ra, rb = result["a"], result["b"]
+        table = Table(title=f"{ra['label']} − {rb['label']} · paired bootstrap, {result['n_resamples']} resamples "
+                            f"over {result['n_environments']} environments")
+        for name in ("distance (m)", f"AP {ra['label']}", f"AP {rb['label']}", "ΔAP ± SD", "95 %"):
+            table.add_column(name, justify="right")
+        for r in result["per_distance"]:
+            table.add_row(f"{r['distance_m']:g}", f"{r['ap_a']:.3f}", f"{r['ap_b']:.3f}",
+                          f"{r['delta_ap']:+.3f} ± {r['sd'] or 0:.3f}", f"{r['ci95'][0]:+.3f} to {r['ci95'][1]:+.3f}")
+        console.print(table)
+        console.print(f"OD50: {ra['label']} {format_od50(ra['od50_m'], ra['censored'], ra['bound_m'])}, "
+                      f"{rb['label']} {format_od50(rb['od50_m'], rb['censored'], rb['bound_m'])}", highlight=False)
+        console.print(result["verdict"], highlight=False)
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+            (out / "compare.json").write_text(json.dumps(result, indent=1))
+            png = plot_compare(result, out / "compare.png")
+            console.print(f"wrote {out / 'compare.json'}, {png}", highlight=False)

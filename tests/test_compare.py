@@ -1,0 +1,116 @@
+"""`benchmark compare`: paired bootstrap of ΔAP per distance and ΔOD50 over the same environments."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from benchmark.compare import CompareError, Side, compare_runs, load_side, verdict
+from benchmark.scoring.synthetic import synthetic_collection
+
+SHA = "f" * 64
+
+
+def side(gt, dets, name="camA", condition="day", sha=SHA, folder="run") -> Side:
+    from pathlib import Path
+
+    results = {"camera": {"name": name}, "condition": condition, "collection": {"manifest_sha256": sha},
+               "scoring_backend": "faster-coco-eval"}
+    return Side(Path(folder), results, gt, dets)
+
+
+def degraded(gt, dets, *, drop=0.5, from_m=25.0, seed=1):
+    """The same run with car detections at ``from_m`` and beyond dropped with probability ``drop``."""
+    rng = np.random.default_rng(seed)
+    distance = {im["id"]: im["distance_m"] for im in gt["images"]}
+    return [d for d in dets if not (d["category_id"] == 3 and distance[d["image_id"]] >= from_m and rng.uniform() < drop)]
+
+
+@pytest.fixture(scope="module")
+def run20():
+    return synthetic_collection(20, seed=3, half_range_m=110.0)
+
+
+def test_identical_runs_give_zero_and_no_difference(run20):
+    gt, dets = run20
+    res = compare_runs(side(gt, dets), side(gt, dets, name="camB"), n_resamples=50)
+    assert res["delta_od50"]["delta_m"] == 0.0
+    assert res["delta_od50"]["ci95_m"] == [0.0, 0.0]
+    assert all(r["delta_ap"] == 0.0 and r["ci95"] == [0.0, 0.0] for r in res["per_distance"])
+    assert res["verdict"].startswith("no difference resolved between camA and camB by day")
+
+
+def test_shifted_run_has_the_known_sign(run20):
+    gt, dets = run20
+    worse = degraded(gt, dets)
+    res = compare_runs(side(gt, dets, name="good"), side(gt, worse, name="bad"), n_resamples=200)
+    od = res["delta_od50"]
+    assert od["delta_m"] > 0 and od["ci95_m"][0] > 0, od
+    assert res["verdict"].startswith("good detects cars ") and "farther than bad by day" in res["verdict"]
+    assert sum(r["delta_ap"] for r in res["per_distance"]) > 0
+    flipped = compare_runs(side(gt, worse, name="bad"), side(gt, dets, name="good"), n_resamples=200)
+    assert flipped["delta_od50"]["delta_m"] == pytest.approx(-od["delta_m"])
+    assert flipped["verdict"].startswith("good detects cars ")  # the farther one is named first
+
+
+def test_mismatched_collections_are_refused(run20):
+    gt, dets = run20
+    with pytest.raises(CompareError, match="different collections"):
+        compare_runs(side(gt, dets), side(gt, dets, sha="0" * 64), n_resamples=10)
+    other_gt, other_dets = synthetic_collection(12, seed=3)
+    with pytest.raises(CompareError, match="different environments"):
+        compare_runs(side(gt, dets), side(other_gt, other_dets), n_resamples=10)
+
+
+def test_paired_interval_is_narrower_than_unpaired(run20):
+    gt, dets = run20
+    worse = degraded(gt, dets, drop=0.3)
+    kw = {"n_resamples": 300, "seed": 5}
+    paired = compare_runs(side(gt, dets), side(gt, worse, name="camB"), paired=True, **kw)
+    unpaired = compare_runs(side(gt, dets), side(gt, worse, name="camB"), paired=False, **kw)
+
+    def width(res):
+        lo, hi = res["delta_od50"]["ci95_m"]
+        return hi - lo
+
+    assert width(paired) < 0.7 * width(unpaired)
+    ap_w = [r["ci95"][1] - r["ci95"][0] for r in paired["per_distance"]]
+    ap_w_un = [r["ci95"][1] - r["ci95"][0] for r in unpaired["per_distance"]]
+    assert sum(ap_w) < sum(ap_w_un)
+
+
+def test_censored_od50_is_not_a_difference():
+    res = {"a": {"label": "cam12", "condition": "day", "od50_m": 281.3, "censored": ">", "bound_m": 200.0},
+           "b": {"label": "cam01", "condition": "day", "od50_m": 89.7, "censored": "", "bound_m": None},
+           "confidence_level": 0.95, "delta_od50": {"delta_m": None, "sd_m": None, "ci95_m": [None, None]},
+           "per_distance": [{"distance_m": 100.0, "ci95": [0.3, 0.6]}, {"distance_m": 25.0, "ci95": [-0.01, 0.04]}]}
+    text = verdict(res)
+    assert text.startswith("cam12 detects cars farther than cam01 by day, by at least 110 m (OD50 > 200 m vs 89.7 m")
+    assert "AP differs at 100 m" in text and "281" not in text
+
+
+def test_cli_runs_and_refuses_in_one_line(tmp_path, run20):
+    from benchmark.cli import app
+
+    gt, dets = run20
+    for name, d, sha in (("a", dets, SHA), ("b", degraded(gt, dets), SHA), ("c", dets, "0" * 64)):
+        folder = tmp_path / name
+        folder.mkdir()
+        results = {"camera": {"name": f"cam-{name}"}, "condition": "day", "collection": {"manifest_sha256": sha}}
+        (folder / "results.json").write_text(json.dumps(results))
+        (folder / "groundtruth.json").write_text(json.dumps(gt))
+        (folder / "detections.json").write_text(json.dumps(d))
+    runner = CliRunner()
+    out = tmp_path / "cmp"
+    res = runner.invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "50", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "cam-a detects cars" in res.output and "50 resamples" in res.output
+    assert (out / "compare.png").stat().st_size > 1000
+    assert json.loads((out / "compare.json").read_text())["paired"] is True
+    assert load_side(tmp_path / "a").camera == "cam-a"
+    bad = runner.invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "c"), "--resamples", "10"])
+    assert bad.exit_code == 2 and "different collections" in bad.output
+    assert "Traceback" not in bad.output

@@ -1,0 +1,158 @@
+"""--environments / --distances: a quick try on part of a collection, marked as a subset run
+everywhere (results.json, the sweep cache key and folder) and refused by `benchmark submit`."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from benchmark.cameras import load_camera
+from benchmark.cli import app
+from benchmark.run import CollectionSubset, parse_subset, run_camera, subset_collection
+from test_sweep_cache import N_ENV, FakeCollection, FakeDetector, fake_run_camera
+
+
+def _lines(output: str) -> list[str]:
+    return [line for line in output.splitlines() if line.strip()]
+
+
+def test_parse_subset_ranges_and_errors(tmp_path):
+    col = FakeCollection(tmp_path)
+    distances = sorted({s.distance_m for s in col.scenes()})
+    assert parse_subset(col) is None
+    sub = parse_subset(col, "0-1,3", f"{distances[0]:g},{distances[1]:g}")
+    assert sub == {"environments": [0, 1, 3], "distances_m": distances[:2]}
+    assert parse_subset(col, f"0-{N_ENV - 1}", None) is None  # every scene: the full run, not a subset
+    view = CollectionSubset(col, sub)
+    assert {(s.environment_id, s.distance_m) for s in view.scenes()} <= {(e, d) for e in (0, 1, 3) for d in distances[:2]}
+    gt = view.groundtruth()
+    assert len(gt["images"]) == len(view.scenes()) > 0
+    assert {a["image_id"] for a in gt["annotations"]} == {im["id"] for im in gt["images"]}
+    assert view.name == col.name and view.manifest_sha256 == col.manifest_sha256  # the rest is the collection's
+    for envs, dists, message in [("0-2,9", None, "unknown environment id(s) 9 (this collection has 0-3)"),
+                                 ("a", None, "'a' is neither an environment id nor a range"),
+                                 ("2-1", None, "empty range"),
+                                 (None, "30", "unknown distance 30 m"),
+                                 (None, "far", "'far' is not a distance")]:
+        with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+            subset_collection(col, envs, dists)
+
+
+def test_run_camera_records_the_subset(tmp_path, monkeypatch):
+    """The real run_camera on a subset: only the chosen scenes, ground truth to match, results.json marked."""
+    import benchmark.camera
+
+    class Capture:
+        rgb8 = np.zeros((8, 8, 3), np.uint8)
+        exposure_s, exposure_short_s = 1e-3, None
+
+    class Detector:
+        name, family, sha256, input_size = "none", "none", "0" * 64, "native"
+
+        def detect(self, images, **kw):
+            return [[] for _ in images]
+
+    class Collection(FakeCollection):
+        def radiance(self, scene_id, condition):
+            return None
+
+    monkeypatch.setattr(benchmark.camera, "simulate", lambda radiance, camera, seed: Capture())
+    col = Collection(tmp_path)
+    view = subset_collection(col, "1", None)
+    results = run_camera(view, load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
+    assert results["subset"]["environments"] == [1]
+    assert set(results["exposure_s"]) == {s.scene_id for s in col.scenes() if s.environment_id == 1}
+    gt = json.loads((tmp_path / "run" / "groundtruth.json").read_text())
+    assert {im["environment_id"] for im in gt["images"]} == {1}
+    assert json.loads((tmp_path / "run" / "results.json").read_text())["subset"] == results["subset"]
+    full = run_camera(col, load_camera("cam01"), "day", Detector(), tmp_path / "full", save_images=False)
+    assert "subset" not in full  # full runs keep their bytes
+
+
+@pytest.fixture
+def fakes(monkeypatch, tmp_path):
+    import benchmark.detectors
+    import metricscenes.store
+
+    def run(collection, *args, **kwargs):  # the fake writes what run_camera writes, with its subset mark
+        results = fake_run_camera(collection, *args, **kwargs)
+        if getattr(collection, "subset", None):
+            results["subset"] = collection.subset
+            (args[3] / "results.json").write_text(json.dumps(results))
+        return results
+
+    monkeypatch.setattr("benchmark.run.run_camera", run)
+    monkeypatch.setattr(metricscenes.store.Collection, "open", classmethod(lambda cls, path: FakeCollection(tmp_path)))
+    monkeypatch.setattr(benchmark.detectors, "load_detector", lambda model, **kw: FakeDetector(name=model))
+    return tmp_path
+
+
+def test_subset_sweep_is_marked_and_never_reused_as_full(fakes):
+    out = fakes / "sw"
+    base = ["sweep", "--collection", str(fakes), "--cameras", "cam01", "--conditions", "day", "--out", str(out),
+            "--resamples", "20", "--mtf-source", "published"]
+    quick = CliRunner().invoke(app, [*base, "--environments", "0-1"])
+    assert quick.exit_code == 0, quick.output
+    assert "subset run (environments 0,1" in quick.output
+    meta = json.loads((out / "sweep.json").read_text())
+    assert meta["subset"]["environments"] == [0, 1]
+    subset_dir = out / meta["runs"][0]["path"]
+    assert subset_dir.name.startswith("cam01-day+subset-")
+    assert json.loads((subset_dir / "results.json").read_text())["subset"]["environments"] == [0, 1]
+    again = CliRunner().invoke(app, [*base, "--environments", "0-1"])  # the same subset: reused
+    assert again.exit_code == 0 and json.loads((out / "sweep.json").read_text())["runs"][0]["reused"]
+    full = CliRunner().invoke(app, base)  # the full sweep: its own folder, computed, not the subset's
+    assert full.exit_code == 0, full.output
+    meta = json.loads((out / "sweep.json").read_text())
+    assert meta["runs"][0] == {"camera": "cam01", "condition": "day", "path": "runs/cam01-day", "reused": False}
+    assert "subset" not in meta and "subset run" not in full.output
+
+
+def test_subset_cache_key(tmp_path):
+    from benchmark.sweep import results_key, run_key
+
+    col = FakeCollection(tmp_path)
+    cam = load_camera("cam01")
+    full_key = run_key(cam, "day", FakeDetector(), col, 0)
+    sub_key = run_key(cam, "day", FakeDetector(), subset_collection(col, "0", None), 0)
+    assert "subset" not in full_key and sub_key["subset"] == {"environments": [0],
+                                                              "distances_m": sorted({s.distance_m for s in col.scenes()})}
+    results = {"camera": {"spec_sha256": cam.sha256()}, "condition": "day", "detector": {"sha256": "d" * 64, "input_size": "multiscale"},
+               "collection": {"manifest_sha256": "f" * 64}, "seed": 0, "subset": sub_key["subset"]}
+    assert results_key(results) == sub_key != full_key
+
+
+@pytest.mark.parametrize("command", ["run", "sweep"])
+@pytest.mark.parametrize("extra, message", [
+    (["--environments", "0-2,7"], "unknown environment id(s) 7"),
+    (["--distances", "33"], "unknown distance 33 m"),
+])
+def test_unknown_subset_is_one_line_before_any_output(fakes, command, extra, message):
+    args = [command, "--collection", str(fakes), "--out", str(fakes / "o"), *extra]
+    args += ["--camera", "cam01"] if command == "run" else ["--cameras", "cam01"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2 and message in result.output
+    assert len(_lines(result.output)) == 1 and not (fakes / "o").exists()
+
+
+def test_submit_refuses_a_subset_run(tmp_path):
+    from benchmark.leaderboard.schema import SubmissionError
+    from benchmark.leaderboard.submission import RESULTS_FORMAT, find_runs
+
+    (tmp_path / "results.json").write_text(json.dumps({"format": RESULTS_FORMAT, "subset": {"environments": [0]}}))
+    with pytest.raises(SubmissionError, match="a subset run"):
+        find_runs(tmp_path)
+    result = CliRunner().invoke(app, ["submit", str(tmp_path), "--name", "quick"])
+    assert result.exit_code != 0 and "a subset run" in result.output and len(_lines(result.output)) == 1
+
+
+def test_run_command_says_it_is_a_subset(fakes):
+    out = fakes / "r"
+    result = CliRunner().invoke(app, ["run", "--camera", "cam01", "--collection", str(fakes), "--out", str(out),
+                                      "--environments", "2", "--distances", "25"])
+    assert result.exit_code == 0, result.output
+    assert "subset run (environments 2; distances 25 m)" in result.output and "benchmark submit" in result.output
+    assert json.loads((out / "results.json").read_text())["subset"] == {"environments": [2], "distances_m": [25.0]}
