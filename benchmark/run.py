@@ -149,7 +149,8 @@ def parse_subset(collection, environments: str | None = None, distances: str | N
     ranges) and ``distances`` such as ``"25,50"`` (metres), each None for all. Returns
     ``{"environments": [...], "distances_m": [...]}``, or None where nothing is left out
     (a "subset" of every scene is the full run). A one-line ValueError names an unknown id
-    or distance and what the collection has."""
+    or distance and what the collection has, and a subset of fewer than two distances (no
+    OD50 without an AP curve)."""
     if environments is None and distances is None:
         return None
     scenes = collection.scenes()
@@ -157,6 +158,9 @@ def parse_subset(collection, environments: str | None = None, distances: str | N
     known_dists = sorted({float(s.distance_m) for s in scenes})
     envs = known_envs if environments is None else _parse_environments(environments, known_envs)
     dists = known_dists if distances is None else _parse_distances(distances, known_dists)
+    if len(dists) < 2:  # OD50 is read off the AP curve between distances
+        raise ValueError(f"--distances {distances}: a run needs two or more distances (the collection has "
+                         f"{', '.join(f'{d:g}' for d in known_dists)} m)")
     if envs == known_envs and dists == known_dists:
         return None
     return {"environments": envs, "distances_m": dists}

@@ -36,7 +36,8 @@ def test_parse_subset_ranges_and_errors(tmp_path):
                                  ("a", None, "'a' is neither an environment id nor a range"),
                                  ("2-1", None, "empty range"),
                                  (None, "30", "unknown distance 30 m"),
-                                 (None, "far", "'far' is not a distance")]:
+                                 (None, "far", "'far' is not a distance"),
+                                 (None, f"{distances[0]:g}", "a run needs two or more distances")]:
         with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
             subset_collection(col, envs, dists)
 
@@ -152,7 +153,7 @@ def test_submit_refuses_a_subset_run(tmp_path):
 def test_run_command_says_it_is_a_subset(fakes):
     out = fakes / "r"
     result = CliRunner().invoke(app, ["run", "--camera", "cam01", "--collection", str(fakes), "--out", str(out),
-                                      "--environments", "2", "--distances", "25"])
+                                      "--environments", "2", "--distances", "25,50"])
     assert result.exit_code == 0, result.output
-    assert "subset run (environments 2; distances 25 m)" in result.output and "benchmark submit" in result.output
-    assert json.loads((out / "results.json").read_text())["subset"] == {"environments": [2], "distances_m": [25.0]}
+    assert "subset run (environments 2; distances 25,50 m)" in result.output and "benchmark submit" in result.output
+    assert json.loads((out / "results.json").read_text())["subset"] == {"environments": [2], "distances_m": [25.0, 50.0]}
