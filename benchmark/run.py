@@ -49,17 +49,12 @@ def check_out_dir(out_dir) -> Path:
     """An output folder for benchmark: its own name follows :func:`check_path_name`, it is
     not a file nor under one, and it is not a collection nor inside one (collections are
     read-only to benchmark)."""
-    from metricscenes.store import collection_containing
+    from metricscenes.store import collection_containing, file_in_the_way
 
     out_dir = Path(out_dir)
     check_path_name(out_dir.name, "--out folder name")  # as typed: 'runs/..' and '.' name no folder
-    if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(f"--out {out_dir} is a file, not a folder")
-    for parent in out_dir.absolute().parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise ValueError(f"--out {out_dir}: {parent} is a file, not a folder")
-            break
+    if problem := file_in_the_way(out_dir):
+        raise ValueError(problem)
     inside = collection_containing(out_dir)
     if inside is not None:
         raise ValueError(f"--out {out_dir} is inside the collection {inside}: collections are read-only to "

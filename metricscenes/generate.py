@@ -203,16 +203,11 @@ def check_out_dir(out_dir: str | Path) -> Path:
     collection, before anything is created: a file, a path through a file, a folder inside
     another collection, or a folder that holds other files and is not a collection."""
     from metricscenes.lock import LOCK_FILE
-    from metricscenes.store import collection_containing
+    from metricscenes.store import collection_containing, file_in_the_way
 
     root = Path(out_dir)
-    if root.exists() and not root.is_dir():
-        raise CollectionError(f"--out {root} is a file, not a folder; choose a folder for the collection")
-    for parent in root.absolute().parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise CollectionError(f"--out {root}: {parent} is a file, not a folder")
-            break
+    if problem := file_in_the_way(root):
+        raise CollectionError(f"{problem}; choose a folder for the collection")
     inside = collection_containing(root)
     if inside is not None and inside != Path(os.path.abspath(root)).resolve():
         raise CollectionError(f"--out {root} is inside the collection {inside}; choose a folder outside it")
