@@ -97,7 +97,7 @@ def run(
     for row in results["per_distance"]:
         table.add_row(f"{row['distance_m']:g}", f"{row['ap']:.3f}", f"{row['ap50']:.3f}", str(row["n_images"]))
     console.print(table)
-    console.print(od50_text(results["od50_m"]))
+    console.print(od50_text(results["per_distance"]))
     if results.get("subset"):
         console.print(subset_text(results["subset"]))
     console.print(f"wrote {out / 'results.json'}")
@@ -170,10 +170,7 @@ def sweep(
         table.add_column(condition, justify="right")
     for camera_name, rows in od50_table.groupby("camera", sort=False):
         by_condition = rows.set_index("condition")
-        cells = []
-        for condition in conds:
-            od, sd = by_condition.loc[condition, "od50_m"], by_condition.loc[condition, "sd_m"]
-            cells.append(sweep_module.od50_cell(by_condition.loc[condition]))
+        cells = [sweep_module.od50_cell(by_condition.loc[condition]) for condition in conds]
         mtf = rows["mtf50_cy_per_mm"].iloc[0]
         table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})", *cells)
     console.print(table)
@@ -238,14 +235,17 @@ def score(
         table.add_row(f"{r['distance_m']:g}", f"{r['ap']:.3f}", f"{r['ap50']:.3f}",
                       f"{r['detected']}/{r['n_images']}", taken)
     console.print(table)
-    console.print(od50_text(distance_od50))
+    console.print(od50_text(rows))
 
 
-def od50_text(od50_m: float | None) -> str:
-    """OD50 for people; None or inf: AP does not fall to 0.5 (the extrapolation never crosses)."""
-    if od50_m is None or od50_m == float("inf"):
-        return "OD50: beyond reach (AP does not fall to 0.5 with distance)"
-    return f"OD50 = {od50_m:.1f} m"
+def od50_text(per_distance: list[dict]) -> str:
+    """OD50 for people, read off the AP curve: a bound where AP does not cross 0.5 inside the
+    measured distances ("OD50 > 200 m", "OD50 < 25 m"), never an extrapolated number."""
+    from benchmark.scoring.od50 import format_od50, od50, od50_censoring
+
+    distances, ap = [r["distance_m"] for r in per_distance], [r["ap"] for r in per_distance]
+    censored, bound_m = od50_censoring(distances, ap)
+    return "OD50 " + format_od50(od50(distances, ap), censored, bound_m)
 
 
 def main() -> None:
