@@ -43,6 +43,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from metricscenes.assets.lamps import HEADLAMP_LENS_CD, scaled_to_luminous  # noqa: F401 (HEADLAMP_LENS_CD: the lens share)
+
 # --- head lamps -----------------------------------------------------------------
 
 LOW_BEAM_CUTOFF_DEG = -0.6
@@ -59,9 +61,6 @@ LOW_BEAM_SPREAD_CD = 3_000.0
 """Wide foreground light (J1383: >= 700-750 cd at 9-15° left and right, 1.5-2° down)."""
 GLARE_FLOOR_CD = 350.0
 """Above the cut-off at H: the ECE B50L limit (350 cd) and J1383's sign-lighting minima."""
-HEADLAMP_LENS_CD = 120.0
-"""Axial intensity of a head lamp's Lambertian lens: the most that keeps lens + beam under
-J1383's 125 cd limit above 10U (see the module doc)."""
 HIGH_BEAM_PEAK_CD = 40_000.0
 """SAE J1383 high beam: H-V 20 000-75 000 cd."""
 
@@ -301,8 +300,6 @@ def textured_spot(texture: SpotTexture, wavelengths_nm, intensity_per_cd, origin
 def head_lamp_spot(beam: str, spd_kind: str, origin_m, forward, lens_cd: float = 0.0) -> dict:
     """Spot emitter of a head lamp at ``origin_m`` aimed along the horizontal ``forward``
     (the vehicle's +x), carrying ``beam`` ('low' or 'high') minus a lens of ``lens_cd``."""
-    from metricscenes.assets.lamps import scaled_to_luminous
-
     wl, per_cd = scaled_to_luminous(spd_kind, 1.0)
     f = np.asarray(forward, float)
     return textured_spot(beam_texture(beam, float(lens_cd)), wl, per_cd, origin_m,
@@ -313,8 +310,6 @@ def luminaire_spot(flux_lm: float, spd_kind: str, origin_m, street_side_y: float
     """Spot emitter of a road luminaire at ``origin_m`` pointing down, its street side
     towards world ``street_side_y`` (+1: +y, -1: -y), carrying the distribution minus a
     lens of ``lens_cd``."""
-    from metricscenes.assets.lamps import scaled_to_luminous
-
     wl, per_cd = scaled_to_luminous(spd_kind, 1.0)
     # look_at down with up = +x gives local x = +y (left); up = -x gives local x = -y.
     up = (1.0, 0.0, 0.0) if street_side_y > 0 else (-1.0, 0.0, 0.0)

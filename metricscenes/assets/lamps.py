@@ -29,7 +29,6 @@ from __future__ import annotations
 import colour
 import numpy as np
 
-from metricscenes.assets.beams import HEADLAMP_LENS_CD
 from metricscenes.assets.parts import spectrum
 from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
 
@@ -115,6 +114,11 @@ def headlamp_spd(kind: str = "led") -> str:
     if spd is None:
         raise ValueError(f"headlamp kind must be 'led' or 'halogen', got {kind!r}")
     return spd
+
+
+HEADLAMP_LENS_CD = 120.0
+"""Axial intensity of a head lamp's Lambertian lens: the most that keeps lens + beam under
+J1383's 125 cd limit above 10U (:mod:`metricscenes.assets.beams`: the beam carries the rest)."""
 
 
 def headlamp(kind: str = "led", lens_area_m2: float = 0.02, intensity_cd: float = HEADLAMP_LENS_CD):
