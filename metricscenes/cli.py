@@ -183,24 +183,46 @@ def preview(
     condition: Annotated[str, typer.Option(help="condition to show")] = "day",
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="PNG to write")] = None,
     columns: Annotated[int, typer.Option(min=1)] = 6,
+    white: Annotated[Optional[float], typer.Option(
+        min=1e-12, help="luminance (cd/m²) drawn at 80 % of full scale, the same for every tile "
+        "(to compare conditions); default: the 99th percentile of the whole sheet's luminance")] = None,
+    per_tile: Annotated[bool, typer.Option("--per-tile", help="expose each tile for itself (a dark scene looks lit)")] = False,
 ) -> None:
-    """Write an sRGB contact sheet of every scene (display rendering, not a camera)."""
-    from metricscenes.preview import contact_sheet, radiance_to_srgb8
+    """Write an sRGB contact sheet of every scene (display rendering, not a camera): one
+    exposure for the whole sheet, so night looks like night."""
+    from metricscenes.photometry import radiance_to_xyz
+    from metricscenes.preview import contact_sheet, white_luminance, xyz_to_srgb8
     from metricscenes.store import Collection
+
+    def xyz(scene):  # at 2x the reference grid, so distant cars stay visible
+        return radiance_to_xyz(c.radiance(scene.scene_id, condition).resample(width * 2, height * 2))
 
     try:
         c = Collection.open(collection)
-        tiles, labels = [], []
         width, height = c.reference_grid
-        for s in c.scenes():
-            # Sample the composite at 2x the reference grid so distant cars stay visible.
-            cube = c.radiance(s.scene_id, condition).resample(width * 2, height * 2)
-            tiles.append(radiance_to_srgb8(cube))
-            labels.append(f"{s.scene_id} {condition}")
+        scenes = c.scenes()
+        sheet_white = white
+        with progress_bar(err) as bar:
+            if sheet_white is None and not per_tile:
+                # Pass 1: the sheet's white from every 4th pixel of every tile (memory stays one tile).
+                task = bar.add_task(f"metering {condition}", total=len(scenes))
+                samples = []
+                for s in scenes:
+                    samples.append(xyz(s)[::2, ::2])
+                    bar.advance(task)
+                sheet_white = white_luminance(samples)
+            task = bar.add_task(f"preview {condition}", total=len(scenes))
+            tiles = []
+            for s in scenes:
+                tile = xyz(s)
+                tiles.append(xyz_to_srgb8(tile, white_luminance([tile]) if per_tile else sheet_white))
+                bar.advance(task)
     except _user_errors() as exc:
         fail(str(exc))
+    labels = [f"{s.scene_id} {condition}" for s in scenes]
     path = contact_sheet(tiles, labels, columns, out or collection / f"preview-{condition}.png")
-    console.print(f"wrote {path}")
+    exposure = "each tile exposed for itself" if per_tile else f"white = {sheet_white:.4g} cd/m² for every tile"
+    console.print(f"wrote {path} ({exposure})")
 
 
 @app.command("export")

@@ -1,7 +1,8 @@
 """Quick-look sRGB renderings of spectral radiance (for people, not for cameras).
 
 Radiance → CIE 1931 XYZ (2° observer, 683 lm/W) → linear sRGB, scaled so that a
-chosen percentile of luminance maps to 0.8, → sRGB transfer curve → 8 bit. This is a
+chosen percentile of luminance maps to 0.8 (of one image, or pooled over a whole contact
+sheet so that every tile of a condition shares one exposure), → sRGB transfer curve → 8 bit. This is a
 display rendering only; cameras model their own sensor and ISP (``benchmark``).
 """
 
@@ -19,11 +20,21 @@ def radiance_to_srgb8(radiance: np.ndarray, percentile: float = 99.0, white: flo
     ``white``: the luminance (cd/m²) drawn at 0.8 of full scale; by default the
     ``percentile`` of the image's own luminance (auto exposure).
     """
+    xyz = radiance_to_xyz(radiance)
+    return xyz_to_srgb8(xyz, white if white is not None else white_luminance([xyz], percentile))
+
+
+def white_luminance(xyz_tiles: list[np.ndarray], percentile: float = 99.0) -> float:
+    """The ``percentile`` of luminance Y (cd/m²) pooled over every pixel of ``xyz_tiles``:
+    one exposure for a whole contact sheet, so a dark condition looks dark."""
+    pooled = np.concatenate([np.ravel(xyz[..., 1]) for xyz in xyz_tiles])
+    return float(np.percentile(pooled, percentile)) or 1.0
+
+
+def xyz_to_srgb8(xyz: np.ndarray, white: float) -> np.ndarray:
+    """(rows, cols, 3) CIE XYZ (Y in cd/m²) → uint8 sRGB with luminance ``white`` at 0.8 of full scale."""
     import colour
 
-    xyz = radiance_to_xyz(radiance)
-    if white is None:
-        white = float(np.percentile(xyz[..., 1], percentile)) or 1.0
     rgb = colour.XYZ_to_RGB(xyz * (0.8 / white), colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
     encoded = colour.cctf_encoding(np.clip(rgb, 0.0, 1.0), function="sRGB")
     return np.round(encoded * 255).astype(np.uint8)

@@ -88,3 +88,31 @@ def test_llvm_variant_never_aborts_the_process(tmp_path):
         assert proc.returncode == 2
     else:  # a libLLVM >= 17 is installed: it renders
         assert (tmp_path / "c" / "groundtruth.json").exists()
+
+
+def test_preview_exposes_the_whole_sheet_once(smoke_collection, tmp_path):
+    """One white for every tile of a condition (a dark scene stays dark next to a lit one);
+    --white fixes it across conditions, so night is darker than day on the same scale."""
+    import numpy as np
+    from PIL import Image
+    from typer.testing import CliRunner
+
+    from metricscenes.cli import app
+    from metricscenes.preview import white_luminance, xyz_to_srgb8
+
+    runner = CliRunner()
+    result = runner.invoke(app, ["preview", str(smoke_collection), "--condition", "night", "--out", str(tmp_path / "n.png")])
+    assert result.exit_code == 0 and "cd/m² for every tile" in result.output
+    mean = {}
+    for condition in ("day", "night"):
+        out = tmp_path / f"{condition}-fixed.png"
+        result = runner.invoke(app, ["preview", str(smoke_collection), "--condition", condition, "--white", "5000",
+                                     "--out", str(out)])
+        assert result.exit_code == 0 and "white = 5000 cd/m²" in result.output
+        mean[condition] = np.asarray(Image.open(out), float).mean()
+    assert mean["night"] < 0.5 * mean["day"]
+    # The rule itself: a tile ten times darker than its neighbour stays darker on a shared white.
+    bright, dark = np.full((4, 4, 3), 10.0), np.full((4, 4, 3), 1.0)
+    white = white_luminance([bright, dark])
+    assert xyz_to_srgb8(dark, white).mean() < xyz_to_srgb8(bright, white).mean()
+    assert xyz_to_srgb8(dark, white_luminance([dark])).mean() == xyz_to_srgb8(bright, white_luminance([bright])).mean()
