@@ -83,10 +83,15 @@ def camera_geometry(collection, camera) -> dict | None:
     camera that sees the whole field (the 13 registry cameras), whose results keep their
     bytes. :class:`benchmark.camera.FieldOfViewError` for a camera that sees more."""
     from benchmark.camera import camera_window
-    from metricscenes.geometry import fov_deg
 
     field = collection_field(collection)
-    window = camera_window(camera, field)
+    return _geometry_record(camera, field, camera_window(camera, field))
+
+
+def _geometry_record(camera, field, window) -> dict | None:
+    """:func:`camera_geometry` of a camera whose window of ``field`` is known."""
+    from metricscenes.geometry import fov_deg
+
     if window == field:
         return None
     return {"hfov_deg": round(camera.hfov_deg, 6), "vfov_deg": round(camera.vfov_deg, 6),
@@ -233,12 +238,13 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     from benchmark.camera import camera_window
 
     out_dir = check_out_dir(out_dir)  # before anything is written
-    camera_window(camera, collection_field(collection))  # a camera wider than the collection: refused here
+    field = collection_field(collection)
+    window = camera_window(camera, field)  # a camera wider than the collection: refused here
     created = [p for p in (out_dir, *out_dir.parents) if not p.exists()]
     out_dir.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out_dir))
     try:
-        results = _run_camera(collection, camera, condition, detector, out_dir, stage, seed=seed,
+        results = _run_camera(collection, camera, condition, detector, stage, field, window, seed=seed,
                               save_images=save_images, backend=backend, progress=progress)
         # Into place, one rename a file: images, detections and ground truth, then
         # results.json last (a sweep takes a run folder with its results.json as finished).
@@ -260,21 +266,19 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     return results
 
 
-def _run_camera(collection, camera, condition: str, detector, out_dir: Path, stage: Path, *, seed: int,
+def _run_camera(collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
                 save_images: bool, backend: str, progress) -> dict:
-    """:func:`run_camera`'s work, writing into ``stage``."""
+    """:func:`run_camera`'s work, writing into ``stage``; ``window`` is the part of the
+    collection's ``field`` the camera samples (and its ground truth follows)."""
     from PIL import Image
 
-    from benchmark.camera import camera_window, simulate
+    from benchmark.camera import simulate
     from benchmark.detectors import coco_category_id
     from benchmark.scoring import ap_by_distance, od50
     from metricscenes import __version__
     from metricscenes.groundtruth import scale_groundtruth
 
-    out_dir = check_out_dir(out_dir)  # before anything is written
-    field = collection_field(collection)
-    window = camera_window(camera, field)  # the window the camera samples (and its ground truth follows)
-    geometry = camera_geometry(collection, camera)
+    geometry = _geometry_record(camera, field, window)
     (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
     scenes = collection.scenes()
     timings = Timings()
