@@ -97,12 +97,8 @@ def esf_mtf(image: np.ndarray, *, oversample: int = 4) -> tuple[np.ndarray, np.n
 
 
 def mtf50(freq: np.ndarray, mtf: np.ndarray) -> float:
-    """First frequency where the MTF falls to 0.5 (linear interpolation)."""
-    below = np.nonzero(mtf < 0.5)[0]
-    if below.size == 0 or below[0] == 0:
-        return float("nan")
-    i = below[0]
-    return float(freq[i - 1] + (mtf[i - 1] - 0.5) * (freq[i] - freq[i - 1]) / (mtf[i - 1] - mtf[i]))
+    """First frequency where the MTF falls to 0.5 (linear interpolation): :func:`mtf_crossing` at 0.5."""
+    return mtf_crossing(freq, mtf, 0.5)
 
 
 def luminance_weights_per_band(sensor_spec: SensorSpec, spectrum: np.ndarray) -> np.ndarray:
@@ -305,8 +301,8 @@ MTF_LEVELS = (0.5, 0.3, 0.1)  # MTF50, MTF30, MTF10: read off every measured cur
 def mtf_crossing(freq: np.ndarray, mtf: np.ndarray, level: float) -> float:
     """First frequency where the MTF falls below ``level`` (linear interpolation), in
     ``freq``'s unit; NaN where the curve starts below it or never falls that far.
-    ``mtf_crossing(f, m, 0.5)`` is :func:`mtf50`."""
-    freq, mtf = np.asarray(freq, float), np.asarray(mtf, float)
+    :func:`mtf50` is its 0.5 crossing. Arrays keep their dtype (float32 curves are read in float32)."""
+    freq, mtf = np.asarray(freq), np.asarray(mtf)
     below = np.nonzero(mtf < level)[0]
     if below.size == 0 or below[0] == 0:
         return float("nan")
