@@ -12,6 +12,8 @@ Geometry: the camera sees its own field, 2·atan(width_px · pixel / 2f) ×
 2·atan(height_px · pixel / 2f), a window of the scene's field centred on the optical
 axis (:func:`camera_window`); a camera whose field exceeds the scene's is refused. The
 13 registry cameras see exactly the reference field, so their window *is* the field.
+A lens with radial distortion (``optics.distortion_k1``, ``distortion_k2``) sees the
+undistorted window its sensor's border maps to, through :mod:`benchmark.distortion`.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from benchmark import distortion as _distortion
 from benchmark import exposure as _exposure
 from benchmark import hdr as _hdr
 from benchmark import isp as _isp
@@ -74,9 +77,17 @@ class FieldOfViewError(ValueError):
 
 def camera_extent(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> TanExtent:
     """The camera's field in tangent coordinates, centred on the optical axis: ±half the
-    pixel array over the focal length. Edges within 10⁻⁶ (relative) of ``field``'s are
-    snapped onto them, so a camera of the reference geometry gets ``field`` itself. Not
-    checked against ``field`` (:func:`camera_window` is)."""
+    pixel array over the focal length (with distortion, the undistorted window its
+    border sees: :attr:`CameraSpec.seen_tan_half_extent`). Edges within 10⁻⁶ (relative)
+    of ``field``'s are snapped onto them, so a camera of the reference geometry gets
+    ``field`` itself. Not checked against ``field`` (:func:`camera_window` is)."""
+    return centred_extent(*camera.seen_tan_half_extent, field)
+
+
+def sensor_extent(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> TanExtent:
+    """The tangent extent the pixel grid spans in the lens's distorted coordinates,
+    ±half the pixel array over the focal length (snapped as :func:`camera_extent`);
+    without distortion, :func:`camera_extent` itself."""
     return centred_extent(camera.tan_half_width, camera.tan_half_height, field)
 
 
@@ -95,6 +106,17 @@ def camera_window(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> Ta
     return window
 
 
+def lens_mapping(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT):
+    """What the camera's ground truth follows: (the extent its pixel grid spans, the
+    lens's map from scene to sensor tangent coordinates or None for an ideal lens), as
+    :func:`metricscenes.groundtruth.scale_groundtruth` takes them (``window``, ``to_sensor``)."""
+    if camera.optics.distortion is None:
+        return camera_window(camera, field), None
+    k1, k2 = camera.optics.distortion
+    camera_window(camera, field)  # refused if it sees more than the field
+    return sensor_extent(camera, field), lambda xy: _distortion.distort(xy, k1, k2)
+
+
 def electron_rate(
     scene: SpectralScene,
     camera: CameraSpec,
@@ -107,12 +129,18 @@ def electron_rate(
 
     ``shape_px`` (rows, cols) and ``extent`` select a window of the sensor (default:
     the full frame: the camera's own field, :func:`camera_window` of the scene's
-    field); the window must be sampled at the camera's pixel pitch.
+    field); the window must be sampled at the camera's pixel pitch. With lens
+    distortion ``extent`` is in the sensor's (distorted) coordinates and the scene is
+    sampled through the distortion (:func:`benchmark.distortion.resample_distorted`).
     """
     rows, cols = shape_px or (camera.height_px, camera.width_px)
     if extent is None:
-        extent = camera_window(camera, scene.extent)
-    radiance = scene.resample(cols, rows, extent)
+        camera_window(camera, scene.extent)  # refuses a camera that sees more than the scene
+        extent = sensor_extent(camera, scene.extent)
+    if camera.optics.distortion is None:
+        radiance = scene.resample(cols, rows, extent)
+    else:
+        radiance = _distortion.resample_distorted(scene, cols, rows, extent, *camera.optics.distortion)
     if not np.all(np.isfinite(radiance)):
         raise ValueError("scene radiance contains NaN or infinite values")
     resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))

@@ -63,18 +63,12 @@ def check_out_dir(out_dir) -> Path:
 
 
 def collection_field(collection):
-    """The field (tangent extent) a collection's plates and ground-truth grid cover: the
-    first scene's plate extent as stored, or the reference field for a collection
-    without scenes (or an object that cannot say)."""
-    from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+    """The field (tangent extent) a collection's plates and ground-truth grid cover
+    (``Collection.field``), or the reference field for an object that cannot say (a
+    test double)."""
+    from metricscenes.geometry import REFERENCE_EXTENT
 
-    scenes = collection.scenes()
-    sampling = getattr(collection, "angular_sampling", None)
-    if not scenes or sampling is None:
-        return REFERENCE_EXTENT
-    plate = next(layer for layer in sampling(scenes[0].scene_id) if layer["layer"] == "plate")
-    field = TanExtent(*(float(v) for v in plate["extent_tan"]))
-    return REFERENCE_EXTENT if field == REFERENCE_EXTENT else field
+    return getattr(collection, "field", REFERENCE_EXTENT)
 
 
 def camera_geometry(collection, camera) -> dict | None:
@@ -272,7 +266,7 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     collection's ``field`` the camera samples (and its ground truth follows)."""
     from PIL import Image
 
-    from benchmark.camera import simulate
+    from benchmark.camera import lens_mapping, simulate
     from benchmark.detectors import coco_category_id
     from benchmark.scoring import ap_by_distance, od50
     from metricscenes import __version__
@@ -313,8 +307,9 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
         if progress:
             progress(i + 1, len(scenes))
 
+    sensor_window, to_sensor = lens_mapping(camera, field)
     groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
-                                    field=field, window=window)
+                                    field=field, window=sensor_window, to_sensor=to_sensor)
     t = time.perf_counter()
     per_distance = ap_by_distance(groundtruth, detections, backend=backend)
     timings.add("score", t)

@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from metricscenes import __version__
-from metricscenes.geometry import HORIZONTAL_FOV_DEG, VERTICAL_FOV_DEG, TanExtent
+from metricscenes.geometry import TanExtent, fov_deg
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, photon_energy_j
 from metricscenes.store import Collection
@@ -111,6 +111,7 @@ def export_hdf5(collection: Collection, scene_id: str, condition: str, out: str 
     cols, rows = grid_for_width(width_px if width_px is not None else default_width_px(scene, ref_grid[0]),
                                 ref_grid)
     extent: TanExtent = scene.extent
+    hfov, vfov = fov_deg(extent)
     energy = composite(scene, cols, rows)
     photons = radiance_to_photons(energy, scene.wavelengths_nm)
     coco = collection.groundtruth()
@@ -134,7 +135,7 @@ def export_hdf5(collection: Collection, scene_id: str, condition: str, out: str 
             "manifest_sha256": collection.manifest_sha256, "scene_id": scene_id, "condition": condition,
             "environment_id": int(image["environment_id"]), "car_id": int(image.get("car_id", -1)),
             "heading": str(image.get("heading", "")), "distance_m": float(image["distance_m"]),
-            "hfov_deg": HORIZONTAL_FOV_DEG, "vfov_deg": VERTICAL_FOV_DEG,
+            "hfov_deg": hfov, "vfov_deg": vfov,
             "extent_tan": np.array(extent.as_tuple()), "width_px": cols, "height_px": rows,
             "mrad_per_px": np.array([1e3 * extent.width / cols, 1e3 * extent.height / rows]),
             "dimension_order": DIMENSION_ORDER,

@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 
 from metricscenes import __version__
-from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco_groundtruth, mask_box_tan
 from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
@@ -65,7 +65,7 @@ def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
     in that film's pixels. ``k`` gives ``inset_pixel_mrad`` sampling unless the window
     would exceed ``inset_max_px`` (near cars, which are large in every camera anyway)."""
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
-    e = REFERENCE_EXTENT
+    e = manifest.reference_grid.field
     bw, bh = box_tan[2] - box_tan[0], box_tan[3] - box_tan[1]
     x0 = max(e.x0, box_tan[0] - INSET_MARGIN["left"] * bw)
     x1 = min(e.x1, box_tan[2] + INSET_MARGIN["right"] * bw)
@@ -94,13 +94,14 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     use_variant(manifest.render.variant, threads)
     root = Path(out_dir)
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    field = manifest.reference_grid.field
     env = unit.environment
     parts = scene_mod.environment_parts(env)
     record: dict = {"unit": unit.key, "kind": unit.kind, "arrays": {}}
     started = time.perf_counter()
     if unit.kind == "plate":
         groups = [g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
-        jobs = [("plates", g, Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT) for g in groups]
+        jobs = [("plates", g, Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field) for g in groups]
     else:
         env_parts = parts
         pose = scene_mod.car_pose(env, unit.distance_m)
@@ -111,7 +112,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         if "car_lights" in manifest.light_groups:
             # The car's lamps light the road far outside its inset (an oncoming car's beams
             # reach the camera): that group also gets a whole frame at plate sampling.
-            jobs.append(("frames", "car_lights", Film(ref_w, ref_h), manifest.render.plate_spp, REFERENCE_EXTENT))
+            jobs.append(("frames", "car_lights", Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field))
     for i, (kind, group, film, spp, extent) in enumerate(jobs):
         if not scene_mod.has_emitters(parts, group):
             continue
@@ -135,8 +136,8 @@ def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray, record: dict):
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     box = car_box_tan(car_vertices_m)
     k, cx, cy, cw, ch = inset_window(box, manifest)
-    film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch)
-    e = REFERENCE_EXTENT
+    e = manifest.reference_grid.field
+    film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch, field=e)
     extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
                        e.x0 + (cx + cw) / film.width * e.width, e.y0 + (cy + ch) / film.height * e.height)
     record.update(projected_box_tan=list(box), inset_scale=k)
@@ -158,9 +159,9 @@ def _ground_truth(manifest: Manifest, unit: Unit, root: Path, env_parts, parts, 
     if mask_box is None:
         raise RenderError(f"{unit.key}: the car is not visible in its inset")
     record["arrays"][f"masks/{unit.key}"] = write_mask(root, unit.key, mask, extent)
-    ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
+    grid = manifest.reference_grid
     return {"box_tan": list(mask_box), "mask_iou": round(box_iou(mask_box, record["projected_box_tan"]), 4),
-            "bbox_xywh": box_tan_to_xywh(mask_box, ref_w, ref_h)}
+            "bbox_xywh": box_tan_to_xywh(mask_box, grid.width_px, grid.height_px, grid.field)}
 
 
 def _progress_path(root: Path, key: str) -> Path:
@@ -189,7 +190,7 @@ def _record_problem(root: Path, group, record: dict, manifest: Manifest) -> str 
             box = mask_box_tan(mask.astype(bool), TanExtent(*attrs["extent_tan"]))
             grid = manifest.reference_grid
             if (box is None or list(box) != record["box_tan"]
-                    or box_tan_to_xywh(box, grid.width_px, grid.height_px) != record["bbox_xywh"]):
+                    or box_tan_to_xywh(box, grid.width_px, grid.height_px, grid.field) != record["bbox_xywh"]):
                 return f"{key}: masks/{key} does not give the recorded box"
     except CollectionError as exc:
         return str(exc)

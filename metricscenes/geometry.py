@@ -65,20 +65,29 @@ def world_to_tan(points_m: np.ndarray) -> np.ndarray:
 def tan_to_pixels(tan_xy: np.ndarray, width_px: int, height_px: int) -> np.ndarray:
     """Map tangent coordinates to continuous pixel coordinates of a grid covering the
     reference field of view (pixel (0, 0)'s top-left corner is 0.0)."""
-    t = np.asarray(tan_xy, dtype=float)
-    e = REFERENCE_EXTENT
-    return np.stack(
-        [(t[..., 0] - e.x0) / e.width * width_px, (t[..., 1] - e.y0) / e.height * height_px], axis=-1
-    )
+    return tan_to_grid(tan_xy, REFERENCE_EXTENT, width_px, height_px)
 
 
 def pixels_to_tan(px_xy: np.ndarray, width_px: int, height_px: int) -> np.ndarray:
     """Inverse of :func:`tan_to_pixels`."""
-    p = np.asarray(px_xy, dtype=float)
-    e = REFERENCE_EXTENT
-    return np.stack(
-        [e.x0 + p[..., 0] / width_px * e.width, e.y0 + p[..., 1] / height_px * e.height], axis=-1
-    )
+    return grid_to_tan(px_xy, REFERENCE_EXTENT, width_px, height_px)
+
+
+def field_extent(hfov_deg: float | None, width_px: int, height_px: int) -> TanExtent:
+    """A collection's field: ``hfov_deg`` horizontally, centred on the optical axis, with
+    the grid's aspect (square pixels in tangent coordinates, as a perspective film has);
+    ``None`` is the reference field (:data:`REFERENCE_EXTENT` itself)."""
+    if hfov_deg is None:
+        return REFERENCE_EXTENT
+    half_w = float(np.tan(np.radians(hfov_deg) / 2))
+    half_h = half_w * height_px / width_px
+    return TanExtent(-half_w, -half_h, half_w, half_h)
+
+
+def horizontal_fov_deg(field: TanExtent) -> float:
+    """A centred field's horizontal field of view, degrees, written as the reference's
+    is (:data:`HORIZONTAL_FOV_DEG`), so the reference field gives that very float."""
+    return float(np.degrees(2 * np.arctan(field.x1)))
 
 
 def fov_deg(extent: TanExtent) -> tuple[float, float]:
@@ -119,3 +128,14 @@ def grid_to_tan(px_xy: np.ndarray, extent: TanExtent, width_px: int, height_px: 
     p = np.asarray(px_xy, dtype=float)
     return np.stack([extent.x0 + p[..., 0] / width_px * extent.width,
                      extent.y0 + p[..., 1] / height_px * extent.height], axis=-1)
+
+
+def extent_border(extent: TanExtent, points_per_edge: int = 513) -> np.ndarray:
+    """(4·points_per_edge, 2) tangent coordinates along the border of ``extent`` (what a
+    monotonic radial lens mapping needs to bound the image of the whole rectangle)."""
+    s = np.linspace(0.0, 1.0, points_per_edge)
+    xs, ys = extent.x0 + s * extent.width, extent.y0 + s * extent.height
+    return np.concatenate([np.stack([xs, np.full_like(s, extent.y0)], axis=1),
+                           np.stack([xs, np.full_like(s, extent.y1)], axis=1),
+                           np.stack([np.full_like(s, extent.x0), ys], axis=1),
+                           np.stack([np.full_like(s, extent.x1), ys], axis=1)])

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, grid_to_tan, tan_to_grid, tan_to_pixels, world_to_tan
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, extent_border, grid_to_tan, tan_to_grid, world_to_tan
 
 CAR_CATEGORY = {"id": 3, "name": "car", "supercategory": "vehicle"}
 
@@ -46,10 +46,10 @@ def box_iou(a, b) -> float:
     return inter / union if union > 0 else 0.0
 
 
-def box_tan_to_xywh(box_tan, width_px: int, height_px: int) -> list[float]:
+def box_tan_to_xywh(box_tan, width_px: int, height_px: int, field: TanExtent = REFERENCE_EXTENT) -> list[float]:
     """Convert a tangent-coordinate box to a COCO ``[x, y, w, h]`` box in a pixel grid
-    covering the reference field of view, clipped to the grid."""
-    corners = tan_to_pixels(np.array([[box_tan[0], box_tan[1]], [box_tan[2], box_tan[3]]]), width_px, height_px)
+    covering ``field`` (default the reference field of view), clipped to the grid."""
+    corners = tan_to_grid(np.array([[box_tan[0], box_tan[1]], [box_tan[2], box_tan[3]]]), field, width_px, height_px)
     x0, y0 = np.clip(corners[0], 0, [width_px, height_px])
     x1, y1 = np.clip(corners[1], 0, [width_px, height_px])
     return [round(float(x0), 4), round(float(y0), 4), round(float(x1 - x0), 4), round(float(y1 - y0), 4)]
@@ -73,7 +73,8 @@ def coco_groundtruth(images: list[dict], boxes_xywh: list[list[float]], info: di
 
 
 def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int, *,
-                      field: TanExtent | None = None, window: TanExtent | None = None) -> dict:
+                      field: TanExtent | None = None, window: TanExtent | None = None,
+                      to_sensor=None) -> dict:
     """The same ground truth on a camera's ``width_px`` × ``height_px`` grid.
 
     ``field``: the field the ground-truth grid covers (the collection's; default the
@@ -82,10 +83,15 @@ def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int, *,
     each box goes through tangent coordinates onto the window (the mapping of
     ``SpectralScene.resample(width_px, height_px, window)``), is clipped to the grid,
     and is dropped where nothing of it is left in the camera's view.
+
+    ``to_sensor``: a lens's map from scene to sensor tangent coordinates (N, 2) → (N, 2)
+    (radial distortion), with ``window`` then in sensor coordinates: each box becomes
+    the bounds of its mapped border (a monotonic radial map sends the border of a box
+    onto the border of its image, so the car stays inside).
     """
     field = REFERENCE_EXTENT if field is None else field
-    if window is not None and window != field:
-        return _groundtruth_in_window(groundtruth, width_px, height_px, field, window)
+    if to_sensor is not None or (window is not None and window != field):
+        return _groundtruth_in_window(groundtruth, width_px, height_px, field, window or field, to_sensor)
     out = {**groundtruth, "images": [], "annotations": []}
     scale = {}
     for image in groundtruth["images"]:
@@ -101,7 +107,7 @@ def scale_groundtruth(groundtruth: dict, width_px: int, height_px: int, *,
 
 
 def _groundtruth_in_window(groundtruth: dict, width_px: int, height_px: int, field: TanExtent,
-                           window: TanExtent) -> dict:
+                           window: TanExtent, to_sensor=None) -> dict:
     out = {**groundtruth, "images": [], "annotations": []}
     grids = {}
     for image in groundtruth["images"]:
@@ -111,9 +117,13 @@ def _groundtruth_in_window(groundtruth: dict, width_px: int, height_px: int, fie
         w_ref, h_ref = grids[ann["image_id"]]
         x, y, w, h = ann["bbox"]
         tan = grid_to_tan(np.array([[x, y], [x + w, y + h]], float), field, w_ref, h_ref)
+        if to_sensor is not None:
+            seen = to_sensor(extent_border(TanExtent(*tan[0], *tan[1])))
+            tan = np.array([seen.min(axis=0), seen.max(axis=0)])
         (x0, y0), (x1, y1) = np.clip(tan_to_grid(tan, window, width_px, height_px), 0.0, [width_px, height_px])
         if x1 <= x0 or y1 <= y0:
             continue  # the car lies outside the camera's field
         box = [float(x0), float(y0), float(x1 - x0), float(y1 - y0)]
         out["annotations"].append({**ann, "bbox": box, "area": box[2] * box[3]})
     return out
+

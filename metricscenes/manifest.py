@@ -67,16 +67,31 @@ def _unique(values, what: str):
 
 
 class ReferenceGrid(_Strict):
-    """Pixel grid of the plates and of the ground-truth boxes (covers the cameras' field of view)."""
+    """Pixel grid of the plates and of the ground-truth boxes, and the field it covers:
+    the reference field (34.3° x 19.6°, the paper's 13 cameras) unless ``hfov_deg`` sets
+    another horizontal field (the vertical one follows the grid's aspect)."""
 
     width_px: Int = Field(ge=16, le=8192)
     height_px: Int = Field(ge=9, le=4608)
+    hfov_deg: Float | None = Field(
+        None, ge=5.0, le=150.0, description="horizontal field of view, degrees (default: the reference field)")
 
     @model_validator(mode="after")
     def _aspect(self) -> "ReferenceGrid":
-        if abs(self.width_px / self.height_px - 16 / 9) > 0.01:
-            raise ValueError("reference_grid must have the cameras' 16:9 aspect (e.g. 480 x 270)")
+        aspect = self.width_px / self.height_px
+        if self.hfov_deg is None and abs(aspect - 16 / 9) > 0.01:
+            raise ValueError("reference_grid must have the reference field's 16:9 aspect (e.g. 480 x 270) "
+                             "unless it sets hfov_deg")
+        if not 1.0 <= aspect <= 4.0:
+            raise ValueError(f"reference_grid aspect {aspect:.3g} must lie between 1 and 4")
         return self
+
+    @property
+    def field(self):
+        """The field the grid covers, in tangent coordinates (:class:`~metricscenes.geometry.TanExtent`)."""
+        from metricscenes.geometry import field_extent
+
+        return field_extent(self.hfov_deg, self.width_px, self.height_px)
 
 
 class RenderSettings(_Strict):
@@ -184,7 +199,7 @@ class Manifest(_Strict):
 
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
-        return canonical_sha256(self.model_dump(mode="json"))
+        return manifest_sha256(self.model_dump(mode="json"))
 
     def largest_film_px(self) -> int:
         """Upper bound on the pixels of the largest film a unit renders: a plate (or a
@@ -193,10 +208,8 @@ class Manifest(_Strict):
         at most ``inset_max_px`` (plus rounding), unless k = 1 (see ``generate.inset_window``)."""
         import math
 
-        from metricscenes.geometry import REFERENCE_EXTENT
-
         w, h = self.reference_grid.width_px, self.reference_grid.height_px
-        k_fine = math.ceil(1e3 * REFERENCE_EXTENT.width / w / self.render.inset_pixel_mrad)
+        k_fine = math.ceil(1e3 * self.reference_grid.field.width / w / self.render.inset_pixel_mrad)
         inset = min((self.render.inset_max_px + 2) ** 2, w * h * k_fine**2)
         return max(w * h, inset)
 
@@ -247,6 +260,22 @@ def canonical_sha256(data) -> str:
     for a manifest and for its copy read back from a collection's YAML."""
     canonical = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+# Fields added after collections were first published, omitted from the hash while unset
+# so that every earlier manifest keeps its sha256 (pinned by protocols and collections).
+HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"),)
+
+
+def manifest_sha256(data: dict) -> str:
+    """sha256 of a manifest's JSON form (``Manifest.model_dump(mode="json")``, or the
+    copy in a collection's resolved manifest): :func:`canonical_sha256` with the
+    :data:`HASHED_ONLY_WHEN_SET` fields left out where they are unset."""
+    data = {key: dict(value) if isinstance(value, dict) else value for key, value in data.items()}
+    for section, key in HASHED_ONLY_WHEN_SET:
+        if isinstance(data.get(section), dict) and data[section].get(key) is None:
+            data[section].pop(key, None)
+    return canonical_sha256(data)
 
 
 def parse_manifest(data: object, source: str = "manifest") -> Manifest:

@@ -15,7 +15,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from metricscenes.geometry import CAMERA_HEIGHT_M, HORIZONTAL_FOV_DEG
+from metricscenes.geometry import CAMERA_HEIGHT_M, REFERENCE_EXTENT, TanExtent, horizontal_fov_deg
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
 
 _active_variant: str | None = None
@@ -88,8 +88,9 @@ def _probe_jit(variant: str) -> None:
 
 @dataclass(frozen=True)
 class Film:
-    """A perspective film covering the reference field of view at ``width x height``
-    pixels, of which only the crop window is rendered (crop = whole film by default)."""
+    """A perspective film covering ``field`` (centred on the optical axis; default the
+    reference field of view) at ``width x height`` pixels, of which only the crop window
+    is rendered (crop = whole film by default)."""
 
     width: int
     height: int
@@ -97,6 +98,7 @@ class Film:
     crop_y: int = 0
     crop_width: int | None = None
     crop_height: int | None = None
+    field: TanExtent = REFERENCE_EXTENT
 
     @property
     def size(self) -> tuple[int, int]:
@@ -131,7 +133,7 @@ def sensor_dict(film: Film, spp: int, seed: int) -> dict:
 
     return {
         "type": "perspective",
-        "fov": HORIZONTAL_FOV_DEG,
+        "fov": horizontal_fov_deg(film.field),
         "fov_axis": "x",
         "near_clip": 0.05,
         "far_clip": 1.0e5,

@@ -36,8 +36,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from metricscenes.geometry import TanExtent
-from metricscenes.manifest import canonical_sha256
+from metricscenes.geometry import TanExtent, field_extent
+from metricscenes.manifest import canonical_sha256, manifest_sha256
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
 
@@ -125,12 +125,14 @@ def _extent(attrs: dict, label: str, path: str) -> TanExtent:
         raise CollectionError(f"{label}: {path} has no valid extent_tan attribute") from None
 
 
-def mask_box_xywh(mask: np.ndarray, extent: TanExtent, width_px: int, height_px: int) -> list[float] | None:
-    """The COCO box a mask gives on the reference grid, exactly as ``generate`` computes it."""
+def mask_box_xywh(mask: np.ndarray, extent: TanExtent, width_px: int, height_px: int,
+                  field: TanExtent) -> list[float] | None:
+    """The COCO box a mask gives on the reference grid (covering ``field``), exactly as
+    ``generate`` computes it."""
     from metricscenes.groundtruth import box_tan_to_xywh, mask_box_tan
 
     box = mask_box_tan(np.asarray(mask, dtype=bool), extent)
-    return None if box is None else box_tan_to_xywh(box, width_px, height_px)
+    return None if box is None else box_tan_to_xywh(box, width_px, height_px, field)
 
 
 def file_in_the_way(out_dir: str | Path) -> str | None:
@@ -273,6 +275,12 @@ class Collection:
         g = self.manifest["reference_grid"]
         return (g["width_px"], g["height_px"])
 
+    @property
+    def field(self) -> TanExtent:
+        """The field of view the plates and the ground-truth grid cover (tangent extent;
+        the reference field unless the manifest set ``reference_grid.hfov_deg``)."""
+        return _grid_field(self.manifest)
+
     def scenes(self) -> list[SceneRecord]:
         return [
             SceneRecord(img["scene_id"], img["id"], img["environment_id"], float(img["distance_m"]))
@@ -395,7 +403,7 @@ class Collection:
         path = f"masks/{scene_id}"
         data, attrs = self._read(path, scene_id)
         extent = _extent(attrs, f"{self.root}: scene {scene_id}", path)
-        problem = _box_problem(img, self._boxes.get(img["id"], []), data, extent)
+        problem = _box_problem(img, self._boxes.get(img["id"], []), data, extent, self.field)
         if problem:
             raise CollectionError(f"{self.root}: {problem}; {REPAIR_HINT}")
         return data.astype(bool, copy=False), extent
@@ -443,10 +451,18 @@ class Collection:
         return verify_collection(self.root)
 
 
-def _box_problem(img: dict, boxes: list, mask: np.ndarray, extent: TanExtent) -> str | None:
-    """Is ``boxes`` (the scene's ground truth) exactly the one box its mask gives? None: yes."""
+def _grid_field(manifest: dict | None) -> TanExtent:
+    """The field a (resolved) manifest's reference grid covers; the reference field where
+    the manifest is absent or predates ``hfov_deg``."""
+    grid = (manifest or {}).get("reference_grid") or {}
+    return field_extent(grid.get("hfov_deg"), grid.get("width_px", 16), grid.get("height_px", 9))
+
+
+def _box_problem(img: dict, boxes: list, mask: np.ndarray, extent: TanExtent, field: TanExtent) -> str | None:
+    """Is ``boxes`` (the scene's ground truth) exactly the one box its mask gives on the
+    reference grid covering ``field``? None: yes."""
     scene_id = img["scene_id"]
-    expected = mask_box_xywh(mask, extent, img["width"], img["height"]) if mask.dtype == bool else None
+    expected = mask_box_xywh(mask, extent, img["width"], img["height"], field) if mask.dtype == bool else None
     if expected is None:
         return f"scene {scene_id}: masks/{scene_id} is empty or not boolean"
     if len(boxes) != 1:
@@ -471,6 +487,7 @@ def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha25
     for ann in groundtruth["annotations"]:
         boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
     problems = []
+    field = _grid_field(resolved["manifest"] if resolved else None)
     if resolved:
         grid = resolved["manifest"].get("reference_grid", {})
         plan = {s.get("scene_id"): s for s in resolved.get("plan", []) if isinstance(s, dict)}
@@ -486,7 +503,8 @@ def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha25
         path = f"masks/{scene_id}"
         try:
             data, attrs = read_checked(root, group, path, arrays.get(path), f"scene {scene_id}")
-            problem = _box_problem(img, boxes.get(img["id"], []), data, _extent(attrs, f"scene {scene_id}", path))
+            problem = _box_problem(img, boxes.get(img["id"], []), data, _extent(attrs, f"scene {scene_id}", path),
+                                   field)
         except (CollectionError, KeyError, TypeError) as exc:
             problem = str(exc) if isinstance(exc, CollectionError) else f"scene {scene_id}: {GROUNDTRUTH_FILE} entry is malformed"
         if problem:
@@ -505,7 +523,7 @@ def _load_resolved(root: Path) -> dict:
     if (not isinstance(resolved, dict) or not isinstance(resolved.get("manifest"), dict)
             or not isinstance(resolved.get("arrays"), dict) or "manifest_sha256" not in resolved):
         raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} lacks 'manifest', 'manifest_sha256' or 'arrays'")
-    if canonical_sha256(resolved["manifest"]) != resolved["manifest_sha256"]:
+    if manifest_sha256(resolved["manifest"]) != resolved["manifest_sha256"]:
         raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: its manifest does not match manifest_sha256 "
                               "(edited or damaged)")
     content = resolved.get("content_sha256")  # absent in collections written before it

@@ -159,5 +159,5 @@ def test_yolov8_pipeline_oracle(tmp_path):
 def test_static_model_native_warns(tmp_path):
     model = write_onnx(tmp_path / "v8.onnx", [1, 3, 64, 64], [1, 84, 84], _yolov8_constant())
     with pytest.warns(UserWarning, match="falls back to 64"):
-        det = load_detector(model)
+        det = load_detector(model, input_size="native")
     assert [p.size_px for p in det.passes] == [64]

@@ -70,6 +70,7 @@ def camera_figures(camera: CameraSpec) -> dict:
         "pixel_array_mm": [round(s.array_width_mm, 6), round(s.array_height_mm, 6)],
         "fov_deg": {"horizontal": round(camera.hfov_deg, 4), "vertical": round(camera.vfov_deg, 4)},
         "ifov_mrad": round(camera.ifov_mrad, 6),
+        "distortion_k1_k2": list(camera.optics.distortion) if camera.optics.distortion else None,
         "nyquist_cy_per_mm": round(camera.nyquist_cy_per_mm, 4),
         "saturation_e": round(saturation, 1),
         "saturation_limited_by": "adc" if adc_e < s.well_capacity_e else "well",
@@ -134,7 +135,9 @@ def figure_rows(figures: dict) -> list[tuple[str, str]]:
     return [
         ("field of view", f"{figures['fov_deg']['horizontal']:.2f}° x {figures['fov_deg']['vertical']:.2f}° "
                           f"(f {figures['focal_length_mm']:g} mm, pixel array {figures['pixel_array_mm'][0]:.4g} x "
-                          f"{figures['pixel_array_mm'][1]:.4g} mm)"),
+                          f"{figures['pixel_array_mm'][1]:.4g} mm"
+                          + (", distortion k1 {:g}, k2 {:g}".format(*figures["distortion_k1_k2"])
+                             if figures["distortion_k1_k2"] else "") + ")"),
         ("IFOV", f"{figures['ifov_mrad']:.4g} mrad per pixel (on the axis)"),
         ("Nyquist", f"{figures['nyquist_cy_per_mm']:.1f} cy/mm"),
         ("saturation", f"{figures['saturation_e']:.0f} e- ({figures['saturation_limited_by']}; well "

@@ -76,7 +76,8 @@ def camera_from_dict(data: Any, source: str = "camera spec", *, spec_dir: str | 
             msg = msg.removeprefix("Value error, ")
         shown = err["type"] != "missing" and not isinstance(err.get("input"), (dict, list))
         value = f" = {err['input']!r}" if shown else ""
-        raise ValueError(f"{source}: field '{loc}'{value}: {msg}{allowed}") from None
+        where = f"field '{loc}'{value}" if loc else "the spec as a whole"
+        raise ValueError(f"{source}: {where}: {msg}{allowed}") from None
 
 
 def _allowed(model: type[BaseModel], loc: tuple) -> str:

@@ -38,10 +38,12 @@ from pydantic import (
     model_validator,
 )
 
+from benchmark.distortion import check_monotonic, undistorted_bounds
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
     REFERENCE_ACTIVE_WIDTH_MM,
     REFERENCE_FOCAL_LENGTH_MM,
+    TanExtent,
 )
 
 _STRICT = ConfigDict(extra="forbid", frozen=True)
@@ -100,6 +102,28 @@ class OpticsSpec(BaseModel):
     f_number: float = Field(..., ge=0.5, le=64.0)
     transmittance: float = Field(1.0, gt=0.0, le=1.0)
     cos4_falloff: bool = False
+    distortion_k1: float = Field(0.0, ge=-1.0, le=1.0)
+    """Brown–Conrady radial distortion, r² term (normalised image coordinates x/f;
+    negative: barrel), :mod:`benchmark.distortion`."""
+    distortion_k2: float = Field(0.0, ge=-1.0, le=1.0)
+    """Brown–Conrady radial distortion, r⁴ term."""
+
+    @property
+    def distortion(self) -> tuple[float, float] | None:
+        """(k1, k2), or None for a distortion-free lens."""
+        return None if self.distortion_k1 == 0.0 and self.distortion_k2 == 0.0 else (
+            self.distortion_k1, self.distortion_k2)
+
+    @model_serializer(mode="wrap")
+    def _omit_zero_distortion(self, handler):
+        # The distortion came after the registry and its leaderboard: written only where
+        # it is not zero, so every earlier spec keeps its canonical JSON, hence its sha256.
+        data = handler(self)
+        if isinstance(data, dict):
+            for key in ("distortion_k1", "distortion_k2"):
+                if data.get(key) == 0.0:
+                    data.pop(key)
+        return data
 
 
 class SensorSpec(BaseModel):
@@ -342,9 +366,16 @@ class CameraSpec(BaseModel):
     def f_number(self) -> float:
         return self.optics.f_number
 
+    @model_validator(mode="after")
+    def _lens_does_not_fold(self) -> "CameraSpec":
+        if self.optics.distortion is not None:
+            check_monotonic(*self.optics.distortion, math.hypot(self.tan_half_width, self.tan_half_height))
+        return self
+
     @property
     def tan_half_width(self) -> float:
-        """tan of half the horizontal field: half the pixel array's width over the focal length."""
+        """tan of half the horizontal field: half the pixel array's width over the focal
+        length (the sensor's half-width in distorted coordinates, :mod:`benchmark.distortion`)."""
         return self.sensor.array_width_mm / 2.0 / self.optics.focal_length_mm
 
     @property
@@ -353,13 +384,25 @@ class CameraSpec(BaseModel):
 
     @property
     def hfov_deg(self) -> float:
-        """Horizontal field of view, degrees: 2·atan(width_px · pixel / 2f)."""
-        return math.degrees(2.0 * math.atan(self.tan_half_width))
+        """Horizontal field of view, degrees: 2·atan(width_px · pixel / 2f) (with distortion:
+        of the undistorted directions the sensor's border sees)."""
+        return math.degrees(2.0 * math.atan(self.seen_tan_half_extent[0]))
 
     @property
     def vfov_deg(self) -> float:
-        """Vertical field of view, degrees: 2·atan(height_px · pixel / 2f)."""
-        return math.degrees(2.0 * math.atan(self.tan_half_height))
+        """Vertical field of view, degrees: 2·atan(height_px · pixel / 2f) (idem)."""
+        return math.degrees(2.0 * math.atan(self.seen_tan_half_extent[1]))
+
+    @property
+    def seen_tan_half_extent(self) -> tuple[float, float]:
+        """Half-width and half-height (tangent units) of the scene window the camera sees:
+        the pixel array's over the focal length, enlarged by barrel (shrunk by
+        pincushion) distortion to the undistorted image of the sensor's border."""
+        if self.optics.distortion is None:
+            return self.tan_half_width, self.tan_half_height
+        hw, hh = self.tan_half_width, self.tan_half_height
+        seen = undistorted_bounds(TanExtent(-hw, -hh, hw, hh), *self.optics.distortion)
+        return seen.x1, seen.y1
 
     @property
     def ifov_mrad(self) -> float:

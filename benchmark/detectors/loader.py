@@ -8,7 +8,7 @@ from benchmark.detectors.base import DetectorError
 from benchmark.detectors.classmap import parse_class_map
 from benchmark.detectors.family import N_CLASSES
 from benchmark.detectors.onnx_detector import FAMILIES, OnnxDetector, check_family, infer_family, open_session
-from benchmark.detectors.policy import parse_input_size
+from benchmark.detectors.policy import DEFAULT_INPUT_SIZE, parse_input_size
 from benchmark.detectors.registry import resolve_model, verify_sha256
 
 
@@ -16,7 +16,7 @@ def load_detector(
     model: str | Path,
     *,
     family: str | None = None,
-    input_size: str | int = "native",
+    input_size: str | int = DEFAULT_INPUT_SIZE,
     threads: int | None = None,
     model_dir: Path | None = None,
     class_map: str | list[str] | None = None,
@@ -25,7 +25,8 @@ def load_detector(
 
     ``model`` is a registry name (file looked up in ``model_dir``, default env
     ``METRICSCENES_MODEL_DIR``) or a path. ``family`` is inspected from the output shape
-    when None. ``input_size``: 'native', 'multiscale' or a multiple of 32 (see ``policy``).
+    when None. ``input_size``: 'multiscale' (the default, as ``benchmark run`` and ``detect``),
+    'native' or a multiple of 32 (see ``policy``).
     ``threads`` sets onnxruntime's intra-op threads. Raises :class:`DetectorError` (one
     line) for a missing file, a non-ONNX file, a wrong output shape or a sha256 mismatch.
     ``class_map``: for a model whose classes are not COCO's 80, the COCO class of each of
