@@ -114,7 +114,7 @@ def sweep(
         help="native | multiscale (native + 640, the reference) | an integer such as 640")] = DEFAULT_INPUT_SIZE,
     resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples of OD50 (over environments)")] = BOOTSTRAP_RESAMPLES,
     seed: Annotated[int, typer.Option(help="sensor noise and bootstrap seed")] = 0,
-    mtf_source: Annotated[str, typer.Option(help="MTF50 of each camera: measured | analytic | published")] = "measured",
+    mtf_source: Annotated[str, typer.Option(help="MTF50 of each camera: measured | analytic | published_group (falling back in that order)")] = "measured",
     threads: Annotated[Optional[int], typer.Option(min=1, help="detector threads")] = None,
     save_images: Annotated[bool, typer.Option(help="write the cameras' sRGB images (for the report's strips)")] = True,
     exposure: Annotated[Optional[str], typer.Option(help=EXPOSURE_HELP)] = None,
@@ -141,8 +141,8 @@ def sweep(
         for condition in conds:
             if condition not in known:
                 fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
-        if mtf_source not in sweep_module.MTF_SOURCES:
-            fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF_SOURCES)}, got {mtf_source!r}")
+        if mtf_source not in sweep_module.MTF50_SOURCES:
+            fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF50_SOURCES)}, got {mtf_source!r}")
         detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])

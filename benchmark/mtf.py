@@ -295,6 +295,34 @@ def measure_mtf50(
     }
 
 
+MTF50_SOURCES = ("measured", "analytic", "published_group")
+"""Where a camera's MTF50 comes from, in the order the one policy (:func:`camera_mtf50`)
+tries them: the slanted edge through the camera (:func:`measure_mtf50`), diffraction ×
+pixel aperture (:func:`mtf50_analytic_cy_per_mm`), the paper's MTF50 group of a registry
+camera (``mtf50_group_cy_per_mm``). ``none``: no source gave a finite value."""
+
+
+def camera_mtf50(camera: CameraSpec, prefer: str = "measured") -> tuple[float | None, str]:
+    """(MTF50 in cycles/mm on the sensor, its source): the first of :data:`MTF50_SOURCES`
+    from ``prefer`` on that gives a finite value, else ``(None, "none")``. The one MTF50
+    policy of sweeps, reports and leaderboard submissions."""
+    if prefer not in MTF50_SOURCES:
+        raise ValueError(f"MTF50 source must be one of {', '.join(MTF50_SOURCES)}, got {prefer!r}")
+    for source in MTF50_SOURCES[MTF50_SOURCES.index(prefer):]:
+        try:
+            if source == "measured":
+                value = measure_mtf50(camera)["mtf50_cy_per_mm"]
+            elif source == "analytic":
+                value = mtf50_analytic_cy_per_mm(camera.pixel_um, camera.f_number, sensor_spec=camera.sensor)
+            else:
+                value = camera.mtf50_group_cy_per_mm
+        except (ValueError, RuntimeError):  # a camera the edge bench cannot image falls through
+            continue
+        if value is not None and math.isfinite(value):
+            return float(value), source
+    return None, "none"
+
+
 MTF_LEVELS = (0.5, 0.3, 0.1)  # MTF50, MTF30, MTF10: read off every measured curve
 
 

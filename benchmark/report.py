@@ -28,9 +28,9 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from benchmark import spm  # noqa: E402
+from benchmark.mtf import camera_mtf50  # noqa: E402
 from benchmark.sweep import (  # noqa: E402
     TABLE_COLUMNS,
-    camera_mtf50,
     illuminance_table,
     load_sweep,
     parse_illuminance_condition,
@@ -264,15 +264,17 @@ def _page(meta: dict, body: str) -> str:
 
 
 def _run_mtf50(cam: dict) -> tuple[float, str]:
-    """MTF50 of a run's camera from the spec recorded in its results.json."""
+    """MTF50 of a run's camera from the spec recorded in its results.json (NaN, "none":
+    no spec, or no source gave one)."""
     from benchmark.cameras import camera_from_dict
 
     spec = json.loads(json.dumps(cam.get("spec") or {}))
     spec.get("sensor", {}).pop("width_px", None), spec.get("sensor", {}).pop("height_px", None)  # computed fields
     try:
-        return camera_mtf50(camera_from_dict(spec))
+        value, source = camera_mtf50(camera_from_dict(spec))
     except ValueError:
         return float("nan"), "none"
+    return (float("nan") if value is None else value), source
 
 
 def _png_base64(image) -> str:

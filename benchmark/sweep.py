@@ -19,9 +19,9 @@ Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
   environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`).
 
-MTF50 comes from ``mtf_source``: ``measured`` (ISO 12233 slanted edge through the camera,
-:func:`benchmark.mtf.measure_mtf50`), ``analytic`` (diffraction × pixel aperture) or
-``published`` (the paper's MTF50 group of a registry camera).
+MTF50 comes from :func:`benchmark.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
+(ISO 12233 slanted edge through the camera), ``analytic`` (diffraction × pixel aperture)
+or ``published_group`` (the paper's MTF50 group of a registry camera).
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
+from benchmark.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
 
@@ -44,7 +45,6 @@ if TYPE_CHECKING:
     from benchmark.cameras.spec import ExposureSpec
 
 SWEEP_FORMAT = "metricscenes-sweep/1"
-MTF_SOURCES = ("measured", "analytic", "published")
 TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
                  "distance_m", "ap", "ap50", "n_images"]
 OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
@@ -119,33 +119,6 @@ def cached_results(run_dir: Path, key: dict) -> dict | None:
     return results
 
 
-def camera_mtf50(camera, source: str = "measured") -> tuple[float, str]:
-    """(MTF50 in cycles/mm on the sensor, the source actually used).
-
-    ``measured`` and ``analytic`` fall back to the next source (analytic, then
-    published) when :mod:`benchmark.mtf` is unavailable or fails.
-    """
-    if source not in MTF_SOURCES:
-        raise ValueError(f"mtf_source must be one of {MTF_SOURCES}, got {source!r}")
-    for candidate in MTF_SOURCES[MTF_SOURCES.index(source):]:
-        try:
-            if candidate == "measured":
-                from benchmark.mtf import measure_mtf50
-
-                value = measure_mtf50(camera)["mtf50_cy_per_mm"]
-            elif candidate == "analytic":
-                from benchmark.mtf import mtf50_analytic_cy_per_mm
-
-                value = mtf50_analytic_cy_per_mm(camera.pixel_um, camera.f_number, sensor_spec=camera.sensor)
-            else:
-                value = camera.mtf50_group_cy_per_mm
-        except (ImportError, ValueError, RuntimeError):
-            continue
-        if value is not None and np.isfinite(value):
-            return float(value), candidate
-    return float("nan"), "none"
-
-
 def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
     """Bootstrap OD50 of one run folder, cached in ``od50.json`` next to its detections."""
     from benchmark.scoring import bootstrap_od50
@@ -187,7 +160,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         n_resamples: bootstrap resamples of OD50 (over environments).
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
             run advances by all its scenes at once.
-        mtf_source: ``measured`` | ``analytic`` | ``published`` (see :func:`camera_mtf50`).
+        mtf_source: ``measured`` | ``analytic`` | ``published_group`` (see :func:`benchmark.mtf.camera_mtf50`).
         exposure: an :class:`ExposureSpec` replacing every camera's exposure block (None:
             each camera's own); it changes the spec sha256 (the cache key) and tags the
             folders of the runs it changed (:func:`run_name`).
@@ -201,8 +174,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.exposure import exposure_tag, format_exposure, with_exposure
     from metricscenes.store import Collection
 
-    if mtf_source not in MTF_SOURCES:
-        raise ValueError(f"mtf_source must be one of {MTF_SOURCES}, got {mtf_source!r}")
+    if mtf_source not in MTF50_SOURCES:
+        raise ValueError(f"mtf_source must be one of {', '.join(MTF50_SOURCES)}, got {mtf_source!r}")
     if isinstance(collection, (str, os.PathLike)):
         collection = Collection.open(collection)
     own = [c if hasattr(c, "sha256") else load_camera(c) for c in cameras]
@@ -236,6 +209,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     rows, od50_rows, runs = [], [], []
     for camera in cameras:
         mtf50, source = camera_mtf50(camera, mtf_source)
+        mtf50 = float("nan") if mtf50 is None else mtf50  # a table cell
         ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
                  "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
         for condition in conditions:

@@ -332,7 +332,7 @@ def test_cli_run_overrides_the_camera_exposure(fakes, monkeypatch):  # noqa: F81
 def test_sweep_policies_do_not_collide(fakes):  # noqa: F811
     out = fakes / "sw"
     base = ["sweep", "--collection", str(fakes), "--cameras", "cam01", "--conditions", "day", "--out", str(out),
-            "--resamples", "10", "--mtf-source", "published", "--no-save-images"]
+            "--resamples", "10", "--mtf-source", "published_group", "--no-save-images"]
     assert CliRunner().invoke(app, base).exit_code == 0
     assert CliRunner().invoke(app, [*base, "--exposure", "hdr:16"]).exit_code == 0
     runs = out / "runs"

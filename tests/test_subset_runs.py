@@ -94,7 +94,7 @@ def fakes(monkeypatch, tmp_path):
 def test_subset_sweep_is_marked_and_never_reused_as_full(fakes):
     out = fakes / "sw"
     base = ["sweep", "--collection", str(fakes), "--cameras", "cam01", "--conditions", "day", "--out", str(out),
-            "--resamples", "20", "--mtf-source", "published"]
+            "--resamples", "20", "--mtf-source", "published_group"]
     quick = CliRunner().invoke(app, [*base, "--environments", "0-1"])
     assert quick.exit_code == 0, quick.output
     assert "subset run (environments 0,1" in quick.output

@@ -215,10 +215,10 @@ def test_killed_sweep_resumes_and_equals_uninterrupted(tmp_path, monkeypatch):
 
 def test_mtf_sources_and_errors(tmp_path, monkeypatch):
     cam = load_camera("cam05")
-    assert sweep_module.camera_mtf50(cam, "published") == (cam.mtf50_group_cy_per_mm, "published")
+    assert sweep_module.camera_mtf50(cam, "published_group") == (cam.mtf50_group_cy_per_mm, "published_group")
     analytic, source = sweep_module.camera_mtf50(cam, "analytic")
     assert source == "analytic" and 30 < analytic < 300
-    with pytest.raises(ValueError, match="mtf_source"):
+    with pytest.raises(ValueError, match="MTF50 source must be one of measured, analytic, published_group"):
         sweep_module.camera_mtf50(cam, "guess")
     with pytest.raises(ValueError, match="unknown condition 'dawn'"):
         make_fake_sweep(tmp_path / "sw", monkeypatch, conditions=("dawn",))

@@ -24,10 +24,10 @@ def fakes(monkeypatch, tmp_path):
 def test_sweep_then_report(fakes):
     out = fakes / "sw"
     args = ["sweep", "--collection", str(fakes), "--cameras", "cam01,12", "--conditions", "day,night",
-            "--out", str(out), "--resamples", "20", "--mtf-source", "published"]
+            "--out", str(out), "--resamples", "20", "--mtf-source", "published_group"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
-    assert "OD50 ± SD" in result.output and "cam12" in result.output and "150.0 (published)" in result.output
+    assert "OD50 ± SD" in result.output and "cam12" in result.output and "150.0 (published_group)" in result.output
     od50 = pd.read_csv(out / "od50.csv")
     row = od50.query("camera == 'cam01' and condition == 'night'").iloc[0]
     assert f"{row.od50_m:.1f} ± {row.sd_m:.1f}" in result.output

@@ -101,16 +101,14 @@ def _detector_licence(detector: dict) -> str:
     return "unknown"
 
 
-def _mtf50(spec) -> tuple[float | None, str]:
-    """Measured MTF50 (ISO 12233 slanted edge through the camera); the published group if that fails."""
-    from benchmark.mtf import measure_mtf50
+def _mtf50(spec, measure: bool) -> tuple[float | None, str]:
+    """The camera's MTF50 by the one policy (:func:`benchmark.mtf.camera_mtf50`): from the
+    slanted edge on when ``measure``, else from the published group on; a measured or
+    analytic value rounded to 0.1 cy/mm."""
+    from benchmark.mtf import camera_mtf50
 
-    try:
-        return round(float(measure_mtf50(spec)["mtf50_cy_per_mm"]), 1), "measured"
-    except Exception:  # noqa: BLE001 -- a camera the MTF bench cannot image still gets a row
-        if spec.mtf50_group_cy_per_mm is not None:
-            return spec.mtf50_group_cy_per_mm, "published_group"
-        return None, "none"
+    value, source = camera_mtf50(spec, "measured" if measure else "published_group")
+    return (round(value, 1) if source in ("measured", "analytic") else value), source
 
 
 def _float(value) -> float:
@@ -202,8 +200,7 @@ def build_submission(
             if key(r) != key(first):
                 raise SubmissionError(f"{run.folder}: {label} differs from {runs[0].folder}'s; one submission is one camera system")
     spec = camera_from_dump(first["camera"]["spec"], source=f"{runs[0].folder}/results.json camera.spec")
-    mtf50, mtf50_source = _mtf50(spec) if measure_mtf else (
-        (spec.mtf50_group_cy_per_mm, "published_group") if spec.mtf50_group_cy_per_mm is not None else (None, "none"))
+    mtf50, mtf50_source = _mtf50(spec, measure_mtf)
     det = first["detector"]
     submission = {
         "format": SUBMISSION_FORMAT,

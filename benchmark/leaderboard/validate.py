@@ -129,8 +129,8 @@ def _check_camera(data: dict, source: str) -> None:
         raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm must be null when mtf50_source is 'none'")
     if kind == "published_group" and value != spec.mtf50_group_cy_per_mm:
         raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm {value} is not the spec's published group {spec.mtf50_group_cy_per_mm}")
-    if kind == "measured" and value is None:
-        raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm is null but mtf50_source is 'measured'")
+    if kind in ("measured", "analytic") and value is None:
+        raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm is null but mtf50_source is {kind!r}")
 
 
 def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) -> None:
