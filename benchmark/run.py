@@ -270,7 +270,7 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     from benchmark.detectors import coco_category_id
     from benchmark.scoring import ap_by_distance, od50
     from metricscenes import __version__
-    from metricscenes.groundtruth import scale_groundtruth
+    from metricscenes.store import scale_groundtruth
 
     geometry = _geometry_record(camera, field, window)
     (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)

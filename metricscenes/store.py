@@ -37,6 +37,7 @@ import numpy as np
 import yaml
 
 from metricscenes.geometry import TanExtent, field_extent
+from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.manifest import canonical_sha256, manifest_sha256
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
