@@ -33,13 +33,13 @@ from benchmark.sweep import (  # noqa: E402
     TABLE_COLUMNS,
     illuminance_table,
     load_sweep,
-    parse_illuminance_condition,
     run_name,
     run_od50,
     with_censoring,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES  # noqa: E402
 from benchmark.scoring.od50 import format_od50  # noqa: E402
+from metricscenes.manifest import parse_illuminance_condition  # noqa: E402
 
 GT_COLOUR, DET_COLOUR = (0, 200, 0), (230, 0, 0)
 CAR_CATEGORY_ID = 3

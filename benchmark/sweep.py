@@ -29,7 +29,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import re
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterable
@@ -40,6 +39,7 @@ import pandas as pd
 from benchmark.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
+from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
     from benchmark.cameras.spec import ExposureSpec
@@ -52,7 +52,6 @@ OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_sour
 # censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
 # extrapolation, report "> farthest m") or "<" (below 0.5 already at the nearest); see benchmark.scoring.od50
 
-_ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")
 
 Progress = Callable[[int, int, str], None]
 
@@ -259,13 +258,6 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                             "spec": exposure.model_dump(mode="json")}
     _write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
     return table
-
-
-def parse_illuminance_condition(condition: str) -> tuple[str, float] | None:
-    """``"day@0.25lux"`` → ``("day", 0.25)`` (an illuminance-sweep condition of
-    :attr:`metricscenes.store.Collection.condition_names`); None for other names."""
-    match = _ILLUMINANCE_CONDITION.fullmatch(str(condition))
-    return (match["base"], float(match["lux"])) if match else None
 
 
 def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:

@@ -105,6 +105,21 @@ class RenderSettings(_Strict):
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral"] = "scalar_spectral"
 
 
+_ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")
+
+
+def illuminance_condition(base: str, lux: float) -> str:
+    """The name of an illuminance-sweep condition: ``("day", 0.25)`` → ``"day@0.25lux"``."""
+    return f"{base}@{lux:g}lux"
+
+
+def parse_illuminance_condition(condition: str) -> tuple[str, float] | None:
+    """Inverse of :func:`illuminance_condition`: ``"day@0.25lux"`` → ``("day", 0.25)``;
+    None for any other name."""
+    match = _ILLUMINANCE_CONDITION.fullmatch(str(condition))
+    return (match["base"], float(match["lux"])) if match else None
+
+
 class IlluminanceSweep(_Strict):
     """Conditions ``<base>@<level>lux``: the base condition with its ambient group scaled
     so that the horizontal illuminance at the camera is ``level`` lux (the paper's

@@ -38,7 +38,7 @@ import yaml
 
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
-from metricscenes.manifest import canonical_sha256, manifest_sha256
+from metricscenes.manifest import canonical_sha256, illuminance_condition, manifest_sha256, parse_illuminance_condition
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
 
@@ -308,7 +308,7 @@ class Collection:
     def condition_names(self) -> list[str]:
         """The manifest's conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
         sweep = self.manifest.get("illuminance_sweep")
-        levels = [f"{sweep['base']}@{lux:g}lux" for lux in sweep["levels_lux"]] if sweep else []
+        levels = [illuminance_condition(sweep["base"], lux) for lux in sweep["levels_lux"]] if sweep else []
         return list(self.conditions) + levels
 
     def _weights(self, condition: str | dict[str, float], environment_id: int) -> dict[str, float]:
@@ -321,7 +321,7 @@ class Collection:
         if condition in self.conditions:
             return dict(self.conditions[condition])
         sweep = self.manifest["illuminance_sweep"]
-        level = float(condition.split("@")[1].removesuffix("lux"))
+        _, level = parse_illuminance_condition(condition)
         weights = dict(self.conditions[sweep["base"]])
         group = sweep["ambient_group"]
         measured = self.resolved["illuminance_lux"][f"env{environment_id:03d}"].get(group, 0.0)

@@ -9,9 +9,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 
 # What `benchmark` may import from `metricscenes`: the store API (collections, their
-# ground truth on any grid), value types (tangent extents, spectral scenes), units
+# ground truth on any grid), value types (manifests, tangent extents, spectral scenes), units
 # (wavelength grid, photometry), small shared helpers (files, CLI) and the version.
-PUBLIC = {"metricscenes", "metricscenes.store", "metricscenes.geometry", "metricscenes.radiance",
+PUBLIC = {"metricscenes", "metricscenes.store", "metricscenes.manifest", "metricscenes.geometry", "metricscenes.radiance",
           "metricscenes.spectral", "metricscenes.photometry", "metricscenes.files", "metricscenes.cli_support"}
 
 
