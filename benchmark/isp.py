@@ -21,7 +21,7 @@ import numpy as np
 
 from benchmark.cameras.spec import ISPSpec, SensorSpec
 from benchmark.demosaic import malvar2004
-from benchmark.sensor import channel_responsivity
+from benchmark.sensor import bayer_sites, channel_responsivity
 from metricscenes.spectral import WAVELENGTHS_NM
 
 _CHECKER = "ColorChecker N Ohta"
@@ -36,10 +36,10 @@ def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
 def grey_world_gains(mosaic: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     """Gains (3,) making the R, G, B means of the mosaic equal (G gain 1)."""
     sums, counts = np.zeros(3), np.zeros(3)
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
+    for dy, dx, channel in bayer_sites(cfa):
         site = mosaic[dy::2, dx::2]
-        sums["RGB".index(ch)] += site.sum(dtype=np.float64)
-        counts["RGB".index(ch)] += site.size
+        sums[channel] += site.sum(dtype=np.float64)
+        counts[channel] += site.size
     means = sums / np.maximum(counts, 1)
     if np.any(means <= 0):
         return np.ones(3)
@@ -63,8 +63,8 @@ def illuminant_gains(sensor: SensorSpec, illuminant: str = "D65") -> np.ndarray:
 
 def apply_gains(mosaic: np.ndarray, gains: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     out = mosaic.copy()
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
-        out[dy::2, dx::2] *= np.float32(gains["RGB".index(ch)])
+    for dy, dx, channel in bayer_sites(cfa):
+        out[dy::2, dx::2] *= np.float32(gains[channel])
     return out
 
 

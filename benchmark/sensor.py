@@ -70,6 +70,13 @@ def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELE
     return effective_qe(sensor, wavelengths_nm) * photons_per_j[None, :] * BAND_WIDTH_NM * area
 
 
+def bayer_sites(cfa: str = "RGGB") -> list[tuple[int, int, int]]:
+    """The four sites of the 2×2 Bayer tile ``cfa`` (read row by row), in that order:
+    (row offset, column offset, channel index 0 R 1 G 2 B). A site's pixels are
+    ``mosaic[dy::2, dx::2]``."""
+    return [(dy, dx, "RGB".index(colour)) for (dy, dx), colour in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa)]
+
+
 def cfa_index(rows: int, cols: int, cfa: str = "RGGB") -> np.ndarray:
     """Channel index (0 R, 1 G, 2 B) of every pixel of a Bayer mosaic, (rows, cols) uint8."""
     lut = {"R": 0, "G": 1, "B": 2}
@@ -81,8 +88,8 @@ def mosaic(channels: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     """Sample (3, rows, cols) channel images on the Bayer pattern: (rows, cols)."""
     _, rows, cols = channels.shape
     out = np.empty((rows, cols), dtype=channels.dtype)
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
-        out[dy::2, dx::2] = channels["RGB".index(ch), dy::2, dx::2]
+    for dy, dx, channel in bayer_sites(cfa):
+        out[dy::2, dx::2] = channels[channel, dy::2, dx::2]
     return out
 
 
