@@ -22,7 +22,7 @@ import numpy as np
 from benchmark.cameras.spec import ISPSpec, SensorSpec
 from benchmark.demosaic import malvar2004
 from benchmark.sensor import bayer_sites, channel_responsivity
-from metricscenes.spectral import WAVELENGTHS_NM
+from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 _CHECKER = "ColorChecker N Ohta"
 
@@ -52,7 +52,7 @@ def illuminant_spectrum(name: str, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) 
         sd = colour.SDS_ILLUMINANTS[name]
     except KeyError:
         raise ValueError(f"isp.illuminant: unknown illuminant {name!r} (e.g. D65, A, D50, F2)") from None
-    return np.interp(wavelengths_nm, sd.wavelengths, sd.values)
+    return resample_spectrum(sd.wavelengths, sd.values, wavelengths_nm, hold_ends=True)
 
 
 def illuminant_gains(sensor: SensorSpec, illuminant: str = "D65") -> np.ndarray:
@@ -84,7 +84,7 @@ def checker_reflectances(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> tuple[l
     """Names and spectral reflectances (24, bands) of the ColorChecker patches."""
     sds = colour.SDS_COLOURCHECKERS[_CHECKER]
     names = list(sds)
-    refl = np.stack([np.interp(wavelengths_nm, sds[n].wavelengths, sds[n].values) for n in names])
+    refl = np.stack([resample_spectrum(sds[n].wavelengths, sds[n].values, wavelengths_nm, hold_ends=True) for n in names])
     return names, refl
 
 

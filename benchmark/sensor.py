@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from benchmark.cameras.spec import SensorSpec
-from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j
+from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j, resample_spectrum
 
 CHANNELS = ("r", "g", "b")
 
@@ -59,7 +59,7 @@ def _read_qe_table(path: str) -> tuple[np.ndarray, np.ndarray]:
 def effective_qe(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
     """Colour-filter QE × IR-cut transmittance, (3, bands), interpolated to the bands."""
     wl, qe = _read_qe_table(str(sensor.qe_path.resolve()))
-    return np.stack([np.interp(wavelengths_nm, wl, q, left=0.0, right=0.0) for q in qe])
+    return np.stack([resample_spectrum(wl, q, wavelengths_nm) for q in qe])
 
 
 def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:

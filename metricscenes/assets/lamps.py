@@ -31,6 +31,7 @@ import numpy as np
 
 from metricscenes.assets.parts import spectrum
 from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
+from metricscenes.spectral import resample_spectrum
 
 K_M_LM_W = MAX_LUMINOUS_EFFICACY_LM_W
 """Maximum luminous efficacy of radiation for photopic vision, lm/W (CIE)."""
@@ -54,7 +55,7 @@ STREET_LIGHT_FLUX_LM = (4000.0, 9000.0, 15000.0)
 def photopic_v(wavelengths_nm: np.ndarray = LAMP_NM) -> np.ndarray:
     """CIE 1924 photopic luminous efficiency V(λ) at ``wavelengths_nm`` (0 outside 360-830)."""
     lef = colour.colorimetry.SDS_LEFS_PHOTOPIC["CIE 1924 Photopic Standard Observer"]
-    return np.interp(np.asarray(wavelengths_nm, float), lef.wavelengths, lef.values, left=0.0, right=0.0)
+    return resample_spectrum(lef.wavelengths, lef.values, wavelengths_nm)
 
 
 def luminous(wavelengths_nm: np.ndarray, spectral_values: np.ndarray) -> float:
@@ -85,7 +86,7 @@ def relative_spd(kind: str) -> np.ndarray:
     else:
         raise ValueError(f"unknown lamp spectrum kind {kind!r}; known: {SPD_KINDS}")
     if sd is not None:
-        values = np.interp(LAMP_NM, sd.wavelengths, sd.values, left=0.0, right=0.0)
+        values = resample_spectrum(sd.wavelengths, sd.values, LAMP_NM)
     values = np.asarray(values, float)
     return values / values.max()
 

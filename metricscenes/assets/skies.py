@@ -36,7 +36,7 @@ import numpy as np
 from metricscenes.assets.lamps import photopic_v
 from metricscenes.assets.parts import spectrum
 from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
-from metricscenes.spectral import WAVELENGTHS_NM
+from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 SKY_KINDS = ("day", "dusk", "night")
 SKIES_PER_KIND = 10
@@ -204,7 +204,7 @@ def expected_illuminance_lux(spec: SkySpec) -> float:
         return twilight_illuminance_lux(spec.sun_elevation_deg)
     if spec.kind == "night":
         moon = spec.moon_normal_illuminance_lux * np.sin(np.radians(spec.moon_elevation_deg))
-        return float(np.pi * luminous_lm(np.interp(WAVELENGTHS_NM, _GRID_NM, night_sky_radiance(spec))) + moon)
+        return float(np.pi * luminous_lm(resample_spectrum(_GRID_NM, night_sky_radiance(spec), hold_ends=True)) + moon)
     raise ValueError(f"expected_illuminance_lux is defined for dusk and night skies, got kind {spec.kind!r}")
 
 
