@@ -22,6 +22,7 @@ import numpy as np
 from benchmark.cameras.spec import ISPSpec, SensorSpec
 from benchmark.demosaic import malvar2004
 from benchmark.sensor import bayer_sites, channel_responsivity
+from metricscenes.photometry import cie_1931_cmfs
 from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 _CHECKER = "ColorChecker N Ohta"
@@ -91,8 +92,7 @@ def checker_reflectances(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> tuple[l
 def checker_targets_linear_srgb(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
     """Linear sRGB (24, 3) of the ColorChecker under D65, perfect white Y = 1."""
     _, refl = checker_reflectances(wavelengths_nm)
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    xyz_bar = np.stack([np.interp(wavelengths_nm, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], 1)
+    xyz_bar = cie_1931_cmfs(wavelengths_nm)
     d65 = illuminant_spectrum("D65", wavelengths_nm)
     xyz = (refl * d65) @ xyz_bar / (d65 @ xyz_bar[:, 1])
     return colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
@@ -196,8 +196,7 @@ def _iset_mcc_matrix_cached(qe_path: str) -> np.ndarray:
     resp = channel_responsivity(sensor)
     d65 = illuminant_spectrum("D65")
     cam = (refl * d65) @ resp.T / (d65 @ resp[1])  # not white-balanced: G of white = 1
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    xyz_bar = np.stack([np.interp(WAVELENGTHS_NM, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], 1)
+    xyz_bar = cie_1931_cmfs(WAVELENGTHS_NM)
     xyz = (refl * d65) @ xyz_bar / (d65 @ xyz_bar[:, 1])
     t, *_ = np.linalg.lstsq(cam, xyz, rcond=None)  # xyz ≈ cam @ t, unconstrained
     return t.T
