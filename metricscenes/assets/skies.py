@@ -78,7 +78,13 @@ class SkySpec:
 
 
 def _planck(wavelengths_nm: np.ndarray, temperature_k: float) -> np.ndarray:
-    """Relative blackbody spectral radiance (Planck's law; arbitrary scale)."""
+    """Relative blackbody spectral radiance (Planck's law; arbitrary scale).
+
+    Not ``colour.colorimetry.planck_law`` (the lamps' halogen uses it): with its rounded
+    c2 = 0.014388 m·K the moon and night-sky spectra move by 3-5e-5, and even given this
+    c2 its c1/π scale and order of operations change their last bits; the rendered
+    collections depend on these spectra to the last bit.
+    """
     lam = np.asarray(wavelengths_nm, dtype=float) * 1e-9
     return 1.0 / (lam**5 * np.expm1(1.4387769e-2 / (lam * temperature_k)))
 
