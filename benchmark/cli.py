@@ -14,7 +14,7 @@ from benchmark.cli_cameras import app as cameras_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark import cli_detect, cli_leaderboard, compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
-from metricscenes.cli import progress_bar
+from metricscenes.cli_support import fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
@@ -38,12 +38,6 @@ def subset_text(subset: dict) -> str:
     envs = ",".join(map(str, subset["environments"]))
     dists = ",".join(f"{d:g}" for d in subset["distances_m"])
     return f"subset run (environments {envs}; distances {dists} m): a quick try, not a full run — `benchmark submit` refuses it"
-
-
-def fail(message: str, code: int = 2) -> None:
-    """One-line error, non-zero exit, no traceback."""
-    err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
-    raise typer.Exit(code)
 
 
 @app.command()

@@ -15,21 +15,17 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmark.cameras import CameraSpec, list_cameras, load_camera
+from metricscenes.cli_support import fail
 
 app = typer.Typer(help="The camera registry: list, show, measure MTF50.", no_args_is_help=True)
 _out = Console()
-
-
-def _fail(message: str) -> None:
-    typer.echo(f"error: {message}", err=True)
-    raise typer.Exit(code=2)
 
 
 def _load(names: list[str]) -> list[CameraSpec]:
     try:
         return [load_camera(n) for n in names] if names else list_cameras()
     except ValueError as exc:
-        _fail(str(exc))
+        fail(str(exc))
 
 
 def _summary(cam: CameraSpec) -> dict:
@@ -75,7 +71,7 @@ def show_command(
         figures = camera_figures(cam)
         warnings = camera_warnings(cam, figures)
     except ValueError as exc:  # e.g. a QE file that cannot be read
-        _fail(f"{cam.name}: {str(exc).splitlines()[0]}")
+        fail(f"{cam.name}: {str(exc).splitlines()[0]}")
     data = {**cam.model_dump(mode="json"), "sha256": cam.sha256()}
     if as_json:
         print(json.dumps({**data, "derived": figures, "warnings": warnings}, indent=2))
@@ -118,12 +114,12 @@ def mtf_command(
 
     cams = _load(names or [])
     if esfr not in ("iso", "isetcam"):
-        _fail(f"unknown e-SFR {esfr!r} (allowed: iso, isetcam)")
+        fail(f"unknown e-SFR {esfr!r} (allowed: iso, isetcam)")
     if isp_name is not None:
         try:
             preset = isp_preset(isp_name)
         except ValueError as exc:
-            _fail(str(exc))
+            fail(str(exc))
         cams = [cam.model_copy(update={"isp": preset}) for cam in cams]
     # the plain command's output stays as it was; the options are named where they apply
     tagged = isp_name is not None or esfr != "iso"
@@ -132,7 +128,7 @@ def mtf_command(
         try:
             m = measure_mtf50(cam, esfr=esfr)
         except ValueError as exc:
-            _fail(f"{cam.name}: {exc}")
+            fail(f"{cam.name}: {exc}")
         curves.append({"name": cam.name, "pixel_um": cam.pixel_um, "freq_cy_per_mm": m["freq_cy_per_mm"], "mtf": m["mtf"]})
         read = mtf_readings(m["freq_cy_per_mm"], m["mtf"], cam.pixel_um)  # MTF30, MTF10 off the same curve
         results.append({
@@ -195,6 +191,6 @@ def _plot(curves: list[dict], path: Path) -> None:
     try:
         fig.savefig(path, dpi=120, bbox_inches="tight")
     except (OSError, ValueError) as exc:
-        _fail(f"cannot write plot {path}: {exc}")
+        fail(f"cannot write plot {path}: {exc}")
     finally:
         plt.close(fig)

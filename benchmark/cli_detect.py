@@ -16,6 +16,7 @@ from rich.table import Table
 
 from benchmark.detectors import DetectorError, load_detector
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
+from metricscenes.cli_support import fail
 
 
 def _read_rgb(path: Path) -> np.ndarray:
@@ -73,8 +74,7 @@ def detect(
             target.parent.mkdir(parents=True, exist_ok=True)
             draw_detections(rgb, dets).save(target)
     except (DetectorError, ValueError, OSError) as exc:
-        err.print(f"error: {exc}", markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(code=2) from None
+        fail(str(exc))
     for target in targets:
         err.print(f"wrote {target}", markup=False, highlight=False, soft_wrap=True)
     if json_out:

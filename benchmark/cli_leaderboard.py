@@ -13,11 +13,7 @@ import typer
 
 from benchmark.leaderboard.schema import SubmissionError
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
-
-
-def _fail(message: str, code: int = 2) -> None:
-    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
-    raise typer.Exit(code)
+from metricscenes.cli_support import fail
 
 
 def submit(
@@ -43,7 +39,7 @@ def submit(
     try:
         if check is not None:
             if results_dir is not None or name is not None:
-                _fail("--check FILE takes no RESULTS_DIR or --name")
+                fail("--check FILE takes no RESULTS_DIR or --name")
             lb = leaderboard if leaderboard.is_dir() else None
             data = check_submission_file(check, leaderboard_dir=lb, detections=detections or [], groundtruth=groundtruth)
             conditions = ", ".join(sorted(data["conditions"]))
@@ -51,16 +47,16 @@ def submit(
             typer.echo(f"ok: {check.name} (protocol {data['collection']['protocol']}, conditions {conditions}{recomputed})")
             return
         if results_dir is None or name is None:
-            _fail("give RESULTS_DIR and --name (or --check FILE)")
+            fail("give RESULTS_DIR and --name (or --check FILE)")
         if detections or groundtruth:
-            _fail("--detections/--groundtruth go with --check; a run folder's own detections.json is always verified")
+            fail("--detections/--groundtruth go with --check; a run folder's own detections.json is always verified")
         groups = group_by_camera(find_runs(results_dir))
         if camera is not None:
             if camera not in groups:
-                _fail(f"camera {camera!r} is not in {results_dir} (cameras: {', '.join(groups)})")
+                fail(f"camera {camera!r} is not in {results_dir} (cameras: {', '.join(groups)})")
             groups = {camera: groups[camera]}
         if len(groups) > 1 and "{camera}" not in name:
-            _fail(f"{results_dir} holds {len(groups)} cameras ({', '.join(groups)}): put {{camera}} in --name or choose one with --camera")
+            fail(f"{results_dir} holds {len(groups)} cameras ({', '.join(groups)}): put {{camera}} in --name or choose one with --camera")
         protocols = load_protocols(leaderboard)
         subs = [build_submission(runs, name=name.replace("{camera}", cam), submitter=submitter, created_at=created_at,
                                  n_resamples=n_resamples, seed=seed, measure_mtf=mtf, protocols=protocols)
@@ -74,7 +70,7 @@ def submit(
             note = f"; not ranked, left out: {', '.join(skipped)}" if skipped else ""
             typer.echo(f"wrote {path} (day OD50 {day}, {n_resamples} bootstrap resamples; conditions {', '.join(sorted(sub['conditions']))}{note})")
     except (SubmissionError, ValueError) as exc:
-        _fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
 
 
 def _od50_text(cond: dict) -> str:
@@ -94,11 +90,11 @@ def leaderboard_cmd(
     from benchmark.leaderboard import render_leaderboard
 
     if not dir.is_dir():
-        _fail(f"{dir}: no such leaderboard folder")
+        fail(f"{dir}: no such leaderboard folder")
     try:
         readme, page = render_leaderboard(dir)
     except (SubmissionError, ValueError) as exc:
-        _fail(f"{str(exc).splitlines()[0]} (the table was not changed)")
+        fail(f"{str(exc).splitlines()[0]} (the table was not changed)")
     typer.echo(f"wrote {readme} and {page}")
 
 
@@ -110,7 +106,7 @@ def schema(which: Annotated[str, typer.Argument(help="which schema: submission")
     from benchmark.leaderboard import schema_text
 
     if which not in SCHEMAS:
-        _fail(f"unknown schema {which!r} (known: {', '.join(SCHEMAS)})")
+        fail(f"unknown schema {which!r} (known: {', '.join(SCHEMAS)})")
     typer.echo(schema_text(), nl=False)
 
 

@@ -302,6 +302,8 @@ def register(app) -> None:
     from rich.console import Console
     from rich.table import Table
 
+    from metricscenes.cli_support import fail
+
     @app.command()
     def compare(
         a: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
@@ -319,8 +321,7 @@ def register(app) -> None:
             with err.status("paired bootstrap"):
                 result = compare_paths(a, b, cameras=camera or (), condition=condition, n_resamples=resamples, seed=seed)
         except (CompareError, ValueError, OSError) as exc:
-            err.print(f"[bold red]error:[/] {str(exc).splitlines()[0]}", highlight=False, soft_wrap=True)
-            raise typer.Exit(2) from None
+            fail(str(exc).splitlines()[0])
         ra, rb = result["a"], result["b"]
         table = Table(title=f"{ra['label']} − {rb['label']} · paired bootstrap, {result['n_resamples']} resamples "
                             f"over {result['n_environments']} environments")

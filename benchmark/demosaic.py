@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from benchmark.sensor import bayer_sites
+
 _PAD = 2  # the kernels' radius
 
 
@@ -58,30 +60,29 @@ def malvar2004(mosaic: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     padded = np.pad(mosaic, _PAD, mode="symmetric")
     out = np.empty((rows, cols, 3), dtype=np.float32)
     f = np.float32
-    for dy in (0, 1):
-        for dx in (0, 1):
-            h, w = len(range(dy, rows, 2)), len(range(dx, cols, 2))
-            if h == 0 or w == 0:
-                continue
-            c, v1, h1, v2, h2, diag = _phase_sums(padded, dy, dx, h, w)
-            site = out[dy::2, dx::2]
-            colour = cfa[2 * dy + dx]
-            if colour == "G":
-                # K1: the colour whose pixels are this row's neighbours; K2: the column's.
-                k1 = f(5) * c + f(4) * h1 - h2 - diag + f(0.5) * v2
-                k2 = f(5) * c + f(4) * v1 - v2 - diag + f(0.5) * h2
-                k1 *= f(0.125)
-                k2 *= f(0.125)
-                row_colour = "R" if "R" in cfa[2 * dy : 2 * dy + 2] else "B"
-                site[..., 1] = c
-                site[..., 0] = k1 if row_colour == "R" else k2
-                site[..., 2] = k2 if row_colour == "R" else k1
-            else:
-                g = f(4) * c + f(2) * (v1 + h1) - (v2 + h2)
-                g *= f(0.125)
-                other = f(6) * c + f(2) * diag - f(1.5) * (v2 + h2)
-                other *= f(0.125)
-                site[..., 1] = g
-                site[..., "RGB".index(colour)] = c
-                site[..., 2 if colour == "R" else 0] = other
+    for dy, dx, channel in bayer_sites(cfa):
+        h, w = len(range(dy, rows, 2)), len(range(dx, cols, 2))
+        if h == 0 or w == 0:
+            continue
+        c, v1, h1, v2, h2, diag = _phase_sums(padded, dy, dx, h, w)
+        site = out[dy::2, dx::2]
+        colour = "RGB"[channel]
+        if colour == "G":
+            # K1: the colour whose pixels are this row's neighbours; K2: the column's.
+            k1 = f(5) * c + f(4) * h1 - h2 - diag + f(0.5) * v2
+            k2 = f(5) * c + f(4) * v1 - v2 - diag + f(0.5) * h2
+            k1 *= f(0.125)
+            k2 *= f(0.125)
+            row_colour = "R" if "R" in cfa[2 * dy : 2 * dy + 2] else "B"
+            site[..., 1] = c
+            site[..., 0] = k1 if row_colour == "R" else k2
+            site[..., 2] = k2 if row_colour == "R" else k1
+        else:
+            g = f(4) * c + f(2) * (v1 + h1) - (v2 + h2)
+            g *= f(0.125)
+            other = f(6) * c + f(2) * diag - f(1.5) * (v2 + h2)
+            other *= f(0.125)
+            site[..., 1] = g
+            site[..., channel] = c
+            site[..., 2 if colour == "R" else 0] = other
     return out

@@ -21,8 +21,9 @@ import numpy as np
 
 from benchmark.cameras.spec import ISPSpec, SensorSpec
 from benchmark.demosaic import malvar2004
-from benchmark.sensor import channel_responsivity
-from metricscenes.spectral import WAVELENGTHS_NM
+from benchmark.sensor import bayer_sites, channel_responsivity
+from metricscenes.photometry import cie_1931_cmfs
+from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 _CHECKER = "ColorChecker N Ohta"
 
@@ -36,10 +37,10 @@ def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
 def grey_world_gains(mosaic: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     """Gains (3,) making the R, G, B means of the mosaic equal (G gain 1)."""
     sums, counts = np.zeros(3), np.zeros(3)
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
+    for dy, dx, channel in bayer_sites(cfa):
         site = mosaic[dy::2, dx::2]
-        sums["RGB".index(ch)] += site.sum(dtype=np.float64)
-        counts["RGB".index(ch)] += site.size
+        sums[channel] += site.sum(dtype=np.float64)
+        counts[channel] += site.size
     means = sums / np.maximum(counts, 1)
     if np.any(means <= 0):
         return np.ones(3)
@@ -52,7 +53,7 @@ def illuminant_spectrum(name: str, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) 
         sd = colour.SDS_ILLUMINANTS[name]
     except KeyError:
         raise ValueError(f"isp.illuminant: unknown illuminant {name!r} (e.g. D65, A, D50, F2)") from None
-    return np.interp(wavelengths_nm, sd.wavelengths, sd.values)
+    return resample_spectrum(sd.wavelengths, sd.values, wavelengths_nm, hold_ends=True)
 
 
 def illuminant_gains(sensor: SensorSpec, illuminant: str = "D65") -> np.ndarray:
@@ -63,8 +64,8 @@ def illuminant_gains(sensor: SensorSpec, illuminant: str = "D65") -> np.ndarray:
 
 def apply_gains(mosaic: np.ndarray, gains: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     out = mosaic.copy()
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
-        out[dy::2, dx::2] *= np.float32(gains["RGB".index(ch)])
+    for dy, dx, channel in bayer_sites(cfa):
+        out[dy::2, dx::2] *= np.float32(gains[channel])
     return out
 
 
@@ -84,15 +85,14 @@ def checker_reflectances(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> tuple[l
     """Names and spectral reflectances (24, bands) of the ColorChecker patches."""
     sds = colour.SDS_COLOURCHECKERS[_CHECKER]
     names = list(sds)
-    refl = np.stack([np.interp(wavelengths_nm, sds[n].wavelengths, sds[n].values) for n in names])
+    refl = np.stack([resample_spectrum(sds[n].wavelengths, sds[n].values, wavelengths_nm, hold_ends=True) for n in names])
     return names, refl
 
 
 def checker_targets_linear_srgb(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
     """Linear sRGB (24, 3) of the ColorChecker under D65, perfect white Y = 1."""
     _, refl = checker_reflectances(wavelengths_nm)
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    xyz_bar = np.stack([np.interp(wavelengths_nm, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], 1)
+    xyz_bar = cie_1931_cmfs(wavelengths_nm)
     d65 = illuminant_spectrum("D65", wavelengths_nm)
     xyz = (refl * d65) @ xyz_bar / (d65 @ xyz_bar[:, 1])
     return colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
@@ -196,8 +196,7 @@ def _iset_mcc_matrix_cached(qe_path: str) -> np.ndarray:
     resp = channel_responsivity(sensor)
     d65 = illuminant_spectrum("D65")
     cam = (refl * d65) @ resp.T / (d65 @ resp[1])  # not white-balanced: G of white = 1
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    xyz_bar = np.stack([np.interp(WAVELENGTHS_NM, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)], 1)
+    xyz_bar = cie_1931_cmfs(WAVELENGTHS_NM)
     xyz = (refl * d65) @ xyz_bar / (d65 @ xyz_bar[:, 1])
     t, *_ = np.linalg.lstsq(cam, xyz, rcond=None)  # xyz ≈ cam @ t, unconstrained
     return t.T

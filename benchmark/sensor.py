@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from benchmark.cameras.spec import SensorSpec
-from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j
+from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j, resample_spectrum
 
 CHANNELS = ("r", "g", "b")
 
@@ -59,7 +59,7 @@ def _read_qe_table(path: str) -> tuple[np.ndarray, np.ndarray]:
 def effective_qe(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
     """Colour-filter QE × IR-cut transmittance, (3, bands), interpolated to the bands."""
     wl, qe = _read_qe_table(str(sensor.qe_path.resolve()))
-    return np.stack([np.interp(wavelengths_nm, wl, q, left=0.0, right=0.0) for q in qe])
+    return np.stack([resample_spectrum(wl, q, wavelengths_nm) for q in qe])
 
 
 def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
@@ -68,6 +68,13 @@ def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELE
     photons_per_j = 1.0 / photon_energy_j(wavelengths_nm)
     area = sensor.pixel_area_m2 * sensor.fill_factor
     return effective_qe(sensor, wavelengths_nm) * photons_per_j[None, :] * BAND_WIDTH_NM * area
+
+
+def bayer_sites(cfa: str = "RGGB") -> list[tuple[int, int, int]]:
+    """The four sites of the 2×2 Bayer tile ``cfa`` (read row by row), in that order:
+    (row offset, column offset, channel index 0 R 1 G 2 B). A site's pixels are
+    ``mosaic[dy::2, dx::2]``."""
+    return [(dy, dx, "RGB".index(colour)) for (dy, dx), colour in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa)]
 
 
 def cfa_index(rows: int, cols: int, cfa: str = "RGGB") -> np.ndarray:
@@ -81,8 +88,8 @@ def mosaic(channels: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
     """Sample (3, rows, cols) channel images on the Bayer pattern: (rows, cols)."""
     _, rows, cols = channels.shape
     out = np.empty((rows, cols), dtype=channels.dtype)
-    for (dy, dx), ch in zip(((0, 0), (0, 1), (1, 0), (1, 1)), cfa):
-        out[dy::2, dx::2] = channels["RGB".index(ch), dy::2, dx::2]
+    for dy, dx, channel in bayer_sites(cfa):
+        out[dy::2, dx::2] = channels[channel, dy::2, dx::2]
     return out
 
 

@@ -39,6 +39,7 @@ import pandas as pd
 from benchmark.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
+from metricscenes.files import write_atomic
 from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
@@ -139,7 +140,7 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
         out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed,
                              backend=results.get("scoring_backend", "faster-coco-eval"))
     out = {**out, "ci95_m": list(out["ci95_m"])}
-    _write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
+    write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
     return _json_safe(out)
 
 
@@ -240,8 +241,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
 
     table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
     od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
-    _write_atomic(out_dir / "sweep.csv", table.to_csv(index=False))
-    _write_atomic(out_dir / "od50.csv", od50_table.to_csv(index=False))
+    write_atomic(out_dir / "sweep.csv", table.to_csv(index=False))
+    write_atomic(out_dir / "od50.csv", od50_table.to_csv(index=False))
     meta = {
         "format": SWEEP_FORMAT,
         "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
@@ -256,7 +257,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     if exposure is not None:  # only then, so that other sweeps keep their bytes
         meta["exposure"] = {"policy": format_exposure(exposure), "tag": exposure_tag(exposure),
                             "spec": exposure.model_dump(mode="json")}
-    _write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
+    write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
     return table
 
 
@@ -320,9 +321,3 @@ def _json_safe(value):
     if isinstance(value, np.integer):
         return int(value)
     return value
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)

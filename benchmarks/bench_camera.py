@@ -26,7 +26,6 @@ import colour_demosaicing
 import numpy as np
 import scipy.fft as sfft
 import scipy.ndimage
-import scipy.sparse as sp
 
 from benchmark import exposure, isp, optics, sensor
 from benchmark.camera import simulate

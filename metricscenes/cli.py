@@ -5,40 +5,20 @@ from __future__ import annotations
 import json
 import sys
 import time
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
 from metricscenes import __version__
+from metricscenes.cli_support import fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="Seeded metric driving scenes rendered as spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).")
 console = Console()
 err = Console(stderr=True)
-
-
-def fail(message: str, code: int = 2) -> None:
-    """One-line error, non-zero exit, no traceback."""
-    err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
-    raise typer.Exit(code)
-
-
-@contextmanager
-def progress_bar(console: Console, disable: bool = False):
-    """A rich progress bar that vanishes if the block fails, so an error stays one line."""
-    bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                   TimeElapsedColumn(), TimeRemainingColumn(), console=console, transient=False, disable=disable)
-    with bar:
-        try:
-            yield bar
-        except BaseException:
-            bar.live.transient = True
-            raise
 
 
 def _user_errors():

@@ -24,7 +24,12 @@ def photon_energy_j(wavelengths_nm: np.ndarray) -> np.ndarray:
 
 
 def resample_spectrum(
-    wavelengths_nm: np.ndarray, values: np.ndarray, target_nm: np.ndarray = WAVELENGTHS_NM
+    wavelengths_nm: np.ndarray, values: np.ndarray, target_nm: np.ndarray = WAVELENGTHS_NM, *,
+    hold_ends: bool = False,
 ) -> np.ndarray:
-    """Linearly interpolate a tabulated spectrum onto ``target_nm`` (zero outside the table)."""
+    """Linearly interpolate a tabulated spectrum onto ``target_nm``: zero outside the table
+    (a filter, a lamp: no light where nothing was measured), or with ``hold_ends`` its end
+    values held (a reflectance, an illuminant, a colour-matching table)."""
+    if hold_ends:
+        return np.interp(target_nm, wavelengths_nm, values)
     return np.interp(target_nm, wavelengths_nm, values, left=0.0, right=0.0)

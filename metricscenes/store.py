@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from metricscenes.files import write_atomic  # noqa: F401  (its home is metricscenes.files; generate imports it from here)
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.manifest import canonical_sha256, illuminance_condition, manifest_sha256, parse_illuminance_condition
@@ -156,13 +157,6 @@ def collection_containing(path: str | Path) -> Path | None:
                 or (folder / PROGRESS_DIR / "manifest_sha256").is_file()):
             return folder
     return None
-
-
-def write_atomic(path: Path, text: str) -> None:
-    """Write a text file through a temporary file and a rename, so readers never see half of it."""
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,

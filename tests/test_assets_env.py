@@ -14,6 +14,7 @@ from metricscenes.render import Film, spectral_film_dict
 from metricscenes.assets import roads, skies  # noqa: E402
 from metricscenes.assets import beams  # noqa: E402
 from metricscenes.assets.streetlights import FACE_SIZE_M, street_light_parts  # noqa: E402
+from metricscenes.photometry import luminous_band_sum  # noqa: E402
 from metricscenes.spectral import WAVELENGTHS_NM  # noqa: E402
 
 
@@ -119,7 +120,7 @@ def test_street_light_illuminance_follows_its_candela_table():
                                origin=[x, y + 0.2, 1], target=[x, y, 0], up=[1, 0, 0]),
                            "film": spectral_film_dict(Film(4, 4)), "sampler": {"type": "stratified", "sample_count": 64}}
         radiance = np.asarray(mi.render(mi.load_dict(scene))).reshape(-1, 31).mean(0)
-        lux = skies.luminous_lm(np.pi * radiance / rho)
+        lux = luminous_band_sum(np.pi * radiance / rho)
         d = np.sqrt(x**2 + y**2 + lamp_z**2)
         table_cd = beams.road_luminaire_cd(flux_lm, x / lamp_z, -y / lamp_z)
         assert lux == pytest.approx(table_cd * lamp_z / d**3, rel=0.05), (x, y)
@@ -155,7 +156,7 @@ def test_sky_emitters_use_physical_spectra():
                     assert e[key]["type"] == "irregular"
         mi.load_dict({"type": "scene", **em})
     moon = skies.lunar_spectrum_w_m2_nm(0.2)
-    assert skies.luminous_lm(np.interp(WAVELENGTHS_NM, skies._GRID_NM, moon)) == pytest.approx(0.2, rel=0.02)
+    assert luminous_band_sum(np.interp(WAVELENGTHS_NM, skies._GRID_NM, moon)) == pytest.approx(0.2, rel=0.02)
 
 
 @pytest.mark.parametrize("sky_id", [0, 9, 12, 19, 21, 28])

@@ -10,7 +10,6 @@ from benchmark.cameras import CameraSpec, load_camera
 from benchmark.sensor import signal_volts_per_electron
 from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
-from metricscenes.spectral import WAVELENGTHS_NM
 
 D65 = isp.illuminant_spectrum("D65")
 

@@ -4,7 +4,6 @@ Tiny ONNX files are written by hand (protobuf wire format), so no `onnx` package
 """
 
 import os
-import struct
 from pathlib import Path
 
 import numpy as np

@@ -245,7 +245,7 @@ def test_render_refuses_a_bad_submission_and_keeps_the_table(app, populated):
 
 
 def test_interrupted_render_leaves_the_old_table(app, populated, monkeypatch):
-    import benchmark.leaderboard.files as files
+    import metricscenes.files as files
 
     assert _invoke(app, ["leaderboard", "--dir", populated])[0].exit_code == 0
     (populated / "submissions" / "ref-cam07.json").unlink()  # the next render would differ

@@ -7,7 +7,6 @@ checked against that entry's sha256, so a corrupted or substituted file is refus
 
 from __future__ import annotations
 
-import hashlib
 import os
 from dataclasses import dataclass
 from functools import lru_cache
@@ -17,6 +16,7 @@ from pathlib import Path
 import yaml
 
 from benchmark.detectors.base import DetectorError
+from metricscenes.files import sha256_file
 
 MODEL_DIR_ENV = "METRICSCENES_MODEL_DIR"
 
@@ -49,14 +49,6 @@ def default_model_dir() -> Path | None:
     """``METRICSCENES_MODEL_DIR`` resolved against the working directory (absolute)."""
     value = os.environ.get(MODEL_DIR_ENV)
     return Path(value).expanduser().resolve() if value else None
-
-
-def sha256_file(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def resolve_model(model: str | Path, model_dir: Path | None = None) -> tuple[Path, ModelEntry | None]:

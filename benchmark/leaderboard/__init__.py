@@ -7,7 +7,7 @@
 See docs/leaderboard.md for the format and the rules.
 """
 
-from benchmark.leaderboard.files import atomic_write_bytes, atomic_write_text, tree_sha256
+from benchmark.leaderboard.files import tree_sha256
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.leaderboard.render import load_submissions, rank_key, render_html, render_leaderboard, render_markdown
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError, check_schema, loads_strict, schema_text, submission_schema
@@ -36,8 +36,6 @@ __all__ = [
     "Protocol",
     "Run",
     "SubmissionError",
-    "atomic_write_bytes",
-    "atomic_write_text",
     "build_submission",
     "check_name",
     "check_not_duplicate",

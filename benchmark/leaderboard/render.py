@@ -3,7 +3,7 @@
 Deterministic: the output depends only on the submissions (and the accepted protocols):
 rows are ranked by daylight OD50, then night OD50 (missing = last), then name; the only
 date shown is the newest submission's ``created_at``. Both files are written atomically
-(:func:`benchmark.leaderboard.files.atomic_write_text`) and only after every submission
+(:func:`metricscenes.files.write_atomic`) and only after every submission
 has validated, so a bad submission or an interrupted render leaves the old table intact.
 
 The HTML page is self-contained: inline CSS and a small vanilla-JS sorter, allowed by a
@@ -23,9 +23,9 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from benchmark.leaderboard.files import atomic_write_text
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.leaderboard.validate import SUBMISSIONS, read_submission_file, validate_submission
+from metricscenes.files import write_atomic
 
 REPRODUCE = """\
 metricscenes generate --manifest manifests/quick.yaml --out collections/quick
@@ -268,4 +268,4 @@ def render_leaderboard(leaderboard_dir: str | Path = "leaderboard") -> tuple[Pat
     protocols = load_protocols(leaderboard_dir)
     submissions = load_submissions(leaderboard_dir, protocols)
     readme, page = render_markdown(submissions, protocols), render_html(submissions, protocols)
-    return atomic_write_text(leaderboard_dir / "README.md", readme), atomic_write_text(leaderboard_dir / "index.html", page)
+    return write_atomic(leaderboard_dir / "README.md", readme), write_atomic(leaderboard_dir / "index.html", page)

@@ -19,11 +19,11 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from benchmark.leaderboard.files import atomic_write_text, sha256_file
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
 from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
+from metricscenes.files import sha256_file, write_atomic
 
 RESULTS_FORMAT = "metricscenes-results/1"
 N_RESAMPLES = BOOTSTRAP_RESAMPLES  # the one default (benchmark.scoring.bootstrap)
@@ -239,4 +239,4 @@ def write_submission(submission: dict, leaderboard_dir: str | Path = "leaderboar
     text = dumps_submission(submission)
     if len(text.encode("utf-8")) > MAX_SUBMISSION_BYTES:
         raise SubmissionError(f"{submission['name']}: submission over the 5 MB limit")
-    return atomic_write_text(leaderboard_dir / SUBMISSIONS / f"{submission['name']}.json", text)
+    return write_atomic(leaderboard_dir / SUBMISSIONS / f"{submission['name']}.json", text)

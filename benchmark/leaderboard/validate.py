@@ -21,9 +21,9 @@ import re
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
-from benchmark.leaderboard.files import sha256_file
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.leaderboard.schema import SubmissionError, check_schema, check_values, loads_strict
+from metricscenes.files import sha256_file
 
 MAX_SUBMISSION_BYTES = 5 * 1024 * 1024
 NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")

@@ -30,10 +30,8 @@ import colour
 import numpy as np
 
 from metricscenes.assets.parts import spectrum
-from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
-
-K_M_LM_W = MAX_LUMINOUS_EFFICACY_LM_W
-"""Maximum luminous efficacy of radiation for photopic vision, lm/W (CIE)."""
+from metricscenes.photometry import luminous_trapezoid
+from metricscenes.spectral import resample_spectrum
 
 LAMP_NM: np.ndarray = np.arange(380.0, 781.0, 5.0)
 """Wavelength grid (nm) of every lamp spectrum in this module."""
@@ -49,21 +47,6 @@ INTENSITY_RANGES_CD: dict[str, tuple[float, float, float]] = {
 }
 STREET_LIGHT_FLUX_LM = (4000.0, 9000.0, 15000.0)
 """(low, typical, high) rated flux of a rural road luminaire, lm."""
-
-
-def photopic_v(wavelengths_nm: np.ndarray = LAMP_NM) -> np.ndarray:
-    """CIE 1924 photopic luminous efficiency V(λ) at ``wavelengths_nm`` (0 outside 360-830)."""
-    lef = colour.colorimetry.SDS_LEFS_PHOTOPIC["CIE 1924 Photopic Standard Observer"]
-    return np.interp(np.asarray(wavelengths_nm, float), lef.wavelengths, lef.values, left=0.0, right=0.0)
-
-
-def luminous(wavelengths_nm: np.ndarray, spectral_values: np.ndarray) -> float:
-    """Photometric value of a spectral quantity: K_m ∫ X(λ) V(λ) dλ (trapezoid).
-
-    W·sr⁻¹·nm⁻¹ gives cd; W·sr⁻¹·m⁻²·nm⁻¹ gives cd/m²; W·m⁻²·nm⁻¹ gives lux.
-    """
-    wl = np.asarray(wavelengths_nm, float)
-    return float(K_M_LM_W * np.trapezoid(np.asarray(spectral_values, float) * photopic_v(wl), wl))
 
 
 def relative_spd(kind: str) -> np.ndarray:
@@ -85,7 +68,7 @@ def relative_spd(kind: str) -> np.ndarray:
     else:
         raise ValueError(f"unknown lamp spectrum kind {kind!r}; known: {SPD_KINDS}")
     if sd is not None:
-        values = np.interp(LAMP_NM, sd.wavelengths, sd.values, left=0.0, right=0.0)
+        values = resample_spectrum(sd.wavelengths, sd.values, LAMP_NM)
     values = np.asarray(values, float)
     return values / values.max()
 
@@ -98,7 +81,7 @@ def scaled_to_luminous(kind: str, luminous_value: float) -> tuple[np.ndarray, np
     if not np.isfinite(luminous_value) or luminous_value < 0:
         raise ValueError(f"luminous_value must be finite and >= 0, got {luminous_value}")
     spd = relative_spd(kind)
-    return LAMP_NM.copy(), spd * (luminous_value / luminous(LAMP_NM, spd))
+    return LAMP_NM.copy(), spd * (luminous_value / luminous_trapezoid(LAMP_NM, spd))
 
 
 def _radiance(kind: str, intensity_cd: float, area_m2: float) -> tuple[np.ndarray, np.ndarray]:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from metricscenes.assets.parts import spectrum
-from metricscenes.spectral import WAVELENGTHS_NM
+from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 _TABLE_NM = np.array([400, 425, 450, 475, 500, 525, 550, 575, 600, 625, 650, 675, 700], dtype=float)
 
@@ -99,7 +99,7 @@ def reflectance(name: str, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.nd
     """Diffuse reflectance (0-1) of a named material at ``wavelengths_nm``."""
     if name not in _REFLECTANCE:
         raise ValueError(f"unknown material {name!r}; known: {sorted(_REFLECTANCE)}")
-    return np.interp(np.asarray(wavelengths_nm, float), _TABLE_NM, _REFLECTANCE[name])
+    return resample_spectrum(_TABLE_NM, _REFLECTANCE[name], wavelengths_nm, hold_ends=True)
 
 
 def paint_reflectance(paint: str, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:

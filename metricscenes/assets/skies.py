@@ -33,10 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from metricscenes.assets.lamps import photopic_v
 from metricscenes.assets.parts import spectrum
-from metricscenes.photometry import MAX_LUMINOUS_EFFICACY_LM_W
-from metricscenes.spectral import WAVELENGTHS_NM
+from metricscenes.photometry import luminous_band_sum
+from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 
 SKY_KINDS = ("day", "dusk", "night")
 SKIES_PER_KIND = 10
@@ -78,22 +77,21 @@ class SkySpec:
         return SKY_LIGHT_GROUPS[self.kind]
 
 
-def luminous_lm(spectral_w_nm: np.ndarray, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> float:
-    """Photometric value (lm, lux or cd/m²) of a spectral quantity sampled every 10 nm."""
-    wl = np.asarray(wavelengths_nm, dtype=float)
-    step = float(np.mean(np.diff(wl)))
-    return float(MAX_LUMINOUS_EFFICACY_LM_W * np.sum(np.asarray(spectral_w_nm) * photopic_v(wl)) * step)
-
-
 def _planck(wavelengths_nm: np.ndarray, temperature_k: float) -> np.ndarray:
-    """Relative blackbody spectral radiance (Planck's law; arbitrary scale)."""
+    """Relative blackbody spectral radiance (Planck's law; arbitrary scale).
+
+    Not ``colour.colorimetry.planck_law`` (the lamps' halogen uses it): with its rounded
+    c2 = 0.014388 m·K the moon and night-sky spectra move by 3-5e-5, and even given this
+    c2 its c1/π scale and order of operations change their last bits; the rendered
+    collections depend on these spectra to the last bit.
+    """
     lam = np.asarray(wavelengths_nm, dtype=float) * 1e-9
     return 1.0 / (lam**5 * np.expm1(1.4387769e-2 / (lam * temperature_k)))
 
 
 def _normalised(values: np.ndarray, photometric: float) -> np.ndarray:
     """Scale a spectrum on ``_GRID_NM`` so that its photometric value equals ``photometric``."""
-    return values * (photometric / luminous_lm(values, _GRID_NM))
+    return values * (photometric / luminous_band_sum(values, _GRID_NM))
 
 
 def lunar_spectrum_w_m2_nm(normal_illuminance_lux: float) -> np.ndarray:
@@ -204,7 +202,7 @@ def expected_illuminance_lux(spec: SkySpec) -> float:
         return twilight_illuminance_lux(spec.sun_elevation_deg)
     if spec.kind == "night":
         moon = spec.moon_normal_illuminance_lux * np.sin(np.radians(spec.moon_elevation_deg))
-        return float(np.pi * luminous_lm(np.interp(WAVELENGTHS_NM, _GRID_NM, night_sky_radiance(spec))) + moon)
+        return float(np.pi * luminous_band_sum(resample_spectrum(_GRID_NM, night_sky_radiance(spec), hold_ends=True)) + moon)
     raise ValueError(f"expected_illuminance_lux is defined for dusk and night skies, got kind {spec.kind!r}")
 
 
@@ -232,7 +230,7 @@ def measure_illuminance_lux(emitters: dict[str, dict], albedo: float = 0.18, siz
              **emitters}
     image = np.asarray(mi.render(mi.load_dict(scene), spp=spp))
     radiance = image.reshape(-1, image.shape[-1]).mean(axis=0)
-    return luminous_lm(np.pi * radiance / albedo)
+    return luminous_band_sum(np.pi * radiance / albedo)
 
 
 def horizontal_illuminance_lux(spec: SkySpec, spp: int = 64) -> float:
@@ -256,7 +254,7 @@ def sky_luminance_cd_m2(spec: SkySpec, elevation_deg: float = 90.0, azimuth_deg:
         si.wavelengths = mi.Spectrum(list(chunk))
         values.extend(list(np.asarray(emitter.eval(si)).ravel()))
     values = values[: len(WAVELENGTHS_NM)]
-    return luminous_lm(np.array(values))
+    return luminous_band_sum(np.array(values))
 
 
 def _chunks(values: np.ndarray, n: int) -> list[np.ndarray]:
