@@ -28,6 +28,7 @@ from benchmark import hdr as _hdr
 from benchmark import isp as _isp
 from benchmark import optics as _optics
 from benchmark import sensor as _sensor
+from benchmark.calibration import calibrate
 from benchmark.cameras.spec import CameraSpec
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, centred_extent, extent_within, fov_deg
 from metricscenes.radiance import SpectralScene
@@ -133,6 +134,21 @@ def electron_rate(
     distortion ``extent`` is in the sensor's (distorted) coordinates and the scene is
     sampled through the distortion (:func:`benchmark.distortion.resample_distorted`).
     """
+    radiance = sensor_radiance(scene, camera, shape_px=shape_px, extent=extent)
+    # The fused fast path: optics and the sensor's spectral integration in one pass over
+    # the bands (benchmark.optics.channel_signal); optical_image + the sensor's
+    # signal_from_irradiance is the plain path it is held equal to (tests/test_camera_speed_paths.py).
+    resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))
+    return _optics.channel_signal(
+        radiance, scene.wavelengths_nm, camera.optics, camera.pixel_um, resp, diffraction=diffraction
+    )
+
+
+def sensor_radiance(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple[int, int] | None = None,
+                    extent: TanExtent | None = None) -> np.ndarray:
+    """The scene's radiance (rows, cols, bands) on the camera's pixel grid (or the window
+    ``shape_px``, ``extent`` of it, as :func:`electron_rate`), through the lens's
+    distortion where it has one; refused (ValueError) where it is not finite."""
     rows, cols = shape_px or (camera.height_px, camera.width_px)
     if extent is None:
         camera_window(camera, scene.extent)  # refuses a camera that sees more than the scene
@@ -143,10 +159,14 @@ def electron_rate(
         radiance = _distortion.resample_distorted(scene, cols, rows, extent, *camera.optics.distortion)
     if not np.all(np.isfinite(radiance)):
         raise ValueError("scene radiance contains NaN or infinite values")
-    resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))
-    return _optics.channel_signal(
-        radiance, scene.wavelengths_nm, camera.optics, camera.pixel_um, resp, diffraction=diffraction
-    )
+    return radiance
+
+
+def optical_image(scene: SpectralScene, camera: CameraSpec, *, diffraction: bool = True) -> _optics.OpticalImage:
+    """The scene through the camera's lens: spectral irradiance on its pixel grid (the
+    plain path, band by band; :func:`electron_rate` fuses it with the sensor)."""
+    return _optics.optical_image(sensor_radiance(scene, camera), scene.wavelengths_nm, camera.optics,
+                                 camera.pixel_um, diffraction=diffraction)
 
 
 def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool = True) -> Capture:
@@ -165,7 +185,7 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
     exposure_s = _exposure.exposure_time_s(rate, camera.sensor, camera.exposure)
     opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
     raw = _sensor.capture_dn(rate, exposure_s, camera.sensor, np.random.default_rng(seed), opts)
-    rgb_linear = _isp.process(raw, camera.sensor, camera.isp)
+    rgb_linear = _isp.process(raw, camera.sensor, camera.isp, calibrate(camera.sensor, camera.isp))
     return Capture(
         rgb8=_isp.encode_srgb8(rgb_linear),
         raw_dn=raw,
@@ -194,7 +214,8 @@ def _simulate_hdr(rate: np.ndarray, camera: CameraSpec, *, seed: int, noise: boo
     raw_short = _sensor.capture_dn(rate, times.short_s, camera.sensor, short_rng, opts)
     merged = _hdr.merge_two_exposures_dn(raw_long, raw_short, times.long_s / times.short_s, camera.sensor)
     # Rescale so that 1 is the reference exposure's white, the tone curve's unit.
-    rgb_linear = _isp.process(merged, camera.sensor, camera.isp) * np.float32(times.reference_s / times.long_s)
+    calibration = calibrate(camera.sensor, camera.isp)
+    rgb_linear = _isp.process(merged, camera.sensor, camera.isp, calibration) * np.float32(times.reference_s / times.long_s)
     toned = _isp.tone_curve_reinhard(rgb_linear, white=times.reference_s / times.short_s)
     return Capture(
         rgb8=_isp.encode_srgb8(toned),

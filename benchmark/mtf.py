@@ -30,6 +30,7 @@ import numpy as np
 import scipy.optimize
 
 from benchmark import exposure, isp, optics, sensor
+from benchmark.calibration import illuminant_gains, illuminant_spectrum
 from benchmark.camera import camera_extent, electron_rate
 from benchmark.cameras.spec import CameraSpec, SensorSpec
 from benchmark.targets import slanted_edge_scene
@@ -131,7 +132,7 @@ def mtf50_analytic_cy_per_mm(
         wl, w = np.array([float(wavelength_nm)]), np.array([1.0])
     else:
         spec = sensor_spec or SensorSpec(pixel_um=pixel_um)
-        illum = isp.illuminant_spectrum("D65") if spectrum is None else spectrum
+        illum = illuminant_spectrum("D65") if spectrum is None else spectrum
         wl, w = WAVELENGTHS_NM, luminance_weights_per_band(spec, illum)
 
     def mtf(f):
@@ -265,7 +266,7 @@ def measure_mtf50(
     roi_px = roi_px or (ISETCAM_ROI_PX if iset else (96, 192))
     if angle_deg is None:
         angle_deg = ISETCAM_EDGE_ANGLE_DEG if iset else 5.0
-    d65 = isp.illuminant_spectrum("D65")
+    d65 = illuminant_spectrum("D65")
     scene, extent = slanted_edge_scene(
         camera.width_px, camera.height_px, d65 * 1e-3, roi_px=roi_px, angle_deg=angle_deg, field=camera_extent(camera)
     )
@@ -277,7 +278,7 @@ def measure_mtf50(
     if camera.isp.white_balance == "none":
         balanced = lin
     else:
-        balanced = isp.apply_gains(lin, isp.illuminant_gains(camera.sensor, "D65"), camera.sensor.cfa)
+        balanced = isp.apply_gains(lin, illuminant_gains(camera.sensor, "D65"), camera.sensor.cfa)
     rgb = isp.demosaic(balanced, camera.isp.demosaic, camera.sensor.cfa)
     lum = rgb @ LUMINANCE_WEIGHTS
     pixel_mm = camera.pixel_um * 1e-3

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as sfft
@@ -201,6 +202,28 @@ def _diffracted_channels(
     for c in range(channels):
         out[c] = sfft.irfft2(acc[c], s=shape, workers=FFT_WORKERS)[pad : pad + rows, pad : pad + cols]
     return out
+
+
+@dataclass(frozen=True)
+class OpticalImage:
+    """Spectral irradiance on the sensor plane (ISETCam's optical image).
+
+    Attributes:
+        irradiance: (rows, cols, bands) float32, W·m⁻²·nm⁻¹, one sample per pixel.
+        wavelengths_nm: (bands,) band centres.
+        pixel_um: the sampling pitch on the sensor, µm.
+    """
+
+    irradiance: np.ndarray
+    wavelengths_nm: np.ndarray
+    pixel_um: float
+
+
+def optical_image(radiance: np.ndarray, wavelengths_nm: np.ndarray, optics: OpticsSpec, pixel_um: float, *,
+                  diffraction: bool = True) -> OpticalImage:
+    """Radiance on the pixel grid → the :class:`OpticalImage` (per band: :func:`irradiance`)."""
+    return OpticalImage(irradiance(radiance, wavelengths_nm, optics, pixel_um, diffraction=diffraction),
+                        np.asarray(wavelengths_nm, float), float(pixel_um))
 
 
 def irradiance(

@@ -70,6 +70,15 @@ def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELE
     return effective_qe(sensor, wavelengths_nm) * photons_per_j[None, :] * BAND_WIDTH_NM * area
 
 
+def signal_from_irradiance(irradiance: np.ndarray, wavelengths_nm: np.ndarray, sensor: SensorSpec) -> np.ndarray:
+    """Noise-free signal per channel (3, rows, cols), electrons·s⁻¹, of a spectral
+    irradiance (rows, cols, bands) in W·m⁻²·nm⁻¹ (an optical image's): Σ_λ r_c(λ)·E(λ)
+    with :func:`channel_responsivity`. The plain path; the camera's fused fast path
+    (``benchmark.optics.channel_signal``) is held equal to it."""
+    resp = channel_responsivity(sensor, np.asarray(wavelengths_nm, float))
+    return np.einsum("hwb,cb->chw", np.asarray(irradiance, np.float64), resp).astype(np.float32)
+
+
 def bayer_sites(cfa: str = "RGGB") -> list[tuple[int, int, int]]:
     """The four sites of the 2×2 Bayer tile ``cfa`` (read row by row), in that order:
     (row offset, column offset, channel index 0 R 1 G 2 B). A site's pixels are

@@ -27,7 +27,7 @@ import numpy as np
 import scipy.fft as sfft
 import scipy.ndimage
 
-from benchmark import exposure, isp, optics, sensor
+from benchmark import calibration, exposure, isp, optics, sensor
 from benchmark.camera import simulate
 from benchmark.cameras import load_camera
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
@@ -116,7 +116,7 @@ def old_isp(raw, s, cfa="RGGB"):
     idx = sensor.cfa_index(*lin.shape, cfa)
     means = np.array([lin[idx == c].mean(dtype=np.float64) for c in range(3)])
     rgb = colour_demosaicing.demosaicing_CFA_Bayer_Malvar2004(isp.apply_gains(lin, means[1] / means, cfa), cfa)
-    m = isp.color_matrix(s).astype(np.float32)
+    m = calibration.color_matrix(s).astype(np.float32)
     return np.einsum("hwc,kc->hwk", np.asarray(rgb, np.float32), m, optimize=True)
 
 
@@ -162,7 +162,7 @@ def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool) 
         repeat,
     )
     rows_out.append(("sensor (noise, ADC)", t, t0))
-    t, t0, lin, lin_old = _pair(lambda: isp.process(raw, cam.sensor, cam.isp), lambda: old_isp(raw, cam.sensor), repeat)
+    t, t0, lin, lin_old = _pair(lambda: isp.process(raw, cam.sensor, cam.isp, calibration.calibrate(cam.sensor, cam.isp)), lambda: old_isp(raw, cam.sensor), repeat)
     rows_out.append(("isp (wb, demosaic, matrix)", t, t0))
     t, _, _, _ = _pair(lambda: isp.encode_srgb8(lin), None, repeat)
     rows_out.append(("srgb encode", t, t))

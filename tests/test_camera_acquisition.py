@@ -10,7 +10,7 @@ import pytest
 from pydantic import ValidationError
 from typer.testing import CliRunner
 
-from benchmark import hdr, isp, sensor
+from benchmark import calibration, hdr, isp, sensor
 from benchmark.camera import electron_rate, simulate
 from benchmark.cameras import ExposureSpec, SensorSpec, list_cameras, load_camera
 from benchmark.cli import app
@@ -26,7 +26,7 @@ from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
 from test_sweep_cli import fakes  # noqa: F401  (fixture)
 
-D65 = isp.illuminant_spectrum("D65")
+D65 = calibration.illuminant_spectrum("D65")
 SENSOR = SensorSpec(pixel_um=1.4)  # IMX363 defaults
 VOLTS_PER_E = 76.5e-6 * 270.0 / 55.0  # conversion gain × analog gain (ISO 270 / ISO 55)
 SWING_V = 0.4591

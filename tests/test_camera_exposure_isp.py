@@ -4,14 +4,14 @@ import colour
 import numpy as np
 import pytest
 
-from benchmark import exposure, isp
+from benchmark import calibration, exposure
 from benchmark.camera import simulate
 from benchmark.cameras import CameraSpec, load_camera
 from benchmark.sensor import signal_volts_per_electron
 from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
 
-D65 = isp.illuminant_spectrum("D65")
+D65 = calibration.illuminant_spectrum("D65")
 
 
 def _with(cam: CameraSpec, **sections) -> CameraSpec:
@@ -96,7 +96,7 @@ def test_grey_patch_is_neutral(white_balance, demosaic):
 
 
 def test_colorchecker_neutrals_are_neutral_and_colours_close():
-    names, refl = isp.checker_reflectances()
+    names, refl = calibration.checker_reflectances()
     patches = (refl * D65 * 2e-3).astype(np.float32).reshape(4, 6, 31)
     cube = np.repeat(np.repeat(patches, 30, axis=0), 30, axis=1)
     scene = SpectralScene(layers=(RadianceLayer(cube, REFERENCE_EXTENT),))
@@ -109,5 +109,5 @@ def test_colorchecker_neutrals_are_neutral_and_colours_close():
     lab = _lab(centres)
     for i in range(19, 23):  # neutral 8 ... neutral 3.5 (white 9.5 may clip)
         assert abs(lab[i, 1]) < 2 and abs(lab[i, 2]) < 2, names[i]
-    assert isp.checker_delta_e2000(cam.sensor).mean() < 4
-    assert np.all(np.abs(isp.color_matrix(cam.sensor).sum(axis=1) - 1) < 1e-9)
+    assert calibration.checker_delta_e2000(cam.sensor).mean() < 4
+    assert np.all(np.abs(calibration.color_matrix(cam.sensor).sum(axis=1) - 1) < 1e-9)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from benchmark import isp
+from benchmark import calibration, isp
+from benchmark import sensor as sensor_module
 from benchmark.cameras import list_cameras, load_camera
 from benchmark.cameras.spec import CameraSpec, ISPSpec, isp_preset
 from benchmark.cli_cameras import app
@@ -77,16 +78,17 @@ def test_parity_demosaic_is_bilinear():
 def test_parity_isp_is_deterministic_and_renders_neutral_grey():
     cam = _parity(load_camera("cam10"))
     raw = np.random.default_rng(0).integers(64, 1023, (16, 20)).astype(np.uint16)
-    a, b = isp.process(raw, cam.sensor, cam.isp), isp.process(raw, cam.sensor, cam.isp)
+    cal = calibration.calibrate(cam.sensor, cam.isp)
+    a, b = isp.process(raw, cam.sensor, cam.isp, cal), isp.process(raw, cam.sensor, cam.isp, cal)
     assert np.array_equal(a, b) and a.dtype == np.float32 and float(a.max()) == 1.0 and float(a.min()) >= 0.0
     m1, m2 = measure_mtf50(cam), measure_mtf50(cam)
     assert m1["mtf50_cy_per_mm"] == m2["mtf50_cy_per_mm"] and np.array_equal(m1["mtf"], m2["mtf"])
     # the ColorChecker greys through ISETCam's MCC transform (no white balance) stay grey
     # (within 8 %: an unconstrained least-squares fit does not pin the neutral axis)
-    _, refl = isp.checker_reflectances()
-    resp = isp.channel_responsivity(cam.sensor)
-    d65 = isp.illuminant_spectrum("D65")
-    greys = isp.iset_render(((refl * d65) @ resp.T / (d65 @ resp[1]))[None].astype(np.float32), cam.sensor)[0, 18:]
+    _, refl = calibration.checker_reflectances()
+    resp = sensor_module.channel_responsivity(cam.sensor)
+    d65 = calibration.illuminant_spectrum("D65")
+    greys = isp.iset_render(((refl * d65) @ resp.T / (d65 @ resp[1]))[None].astype(np.float32), calibration.iset_mcc_matrix(cam.sensor))[0, 18:]
     assert np.all(np.abs(greys / greys[:, 1:2] - 1) < 0.08)
 
 

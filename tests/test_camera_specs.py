@@ -108,7 +108,7 @@ def test_qe_user_file_is_read_beside_the_spec_file(tmp_path, monkeypatch):
     import numpy as np
 
     from benchmark.cameras import DATA_DIR
-    from benchmark.isp import color_matrix
+    from benchmark.calibration import color_matrix
     from benchmark.sensor import effective_qe
 
     folder = tmp_path / "mycam"

@@ -92,6 +92,29 @@ def test_fast_channel_signal_on_band_planar_input_equals_per_band_irradiance(nam
     )
 
 
+@pytest.mark.parametrize("distortion", [None, (-0.1, 0.02)])
+def test_electron_rate_is_the_optical_image_through_the_sensor(distortion):
+    """The camera's fused path equals the plain one through the values between stages:
+    scene → optical image (irradiance on the pixel grid) → sensor signal."""
+    from benchmark.camera import electron_rate, optical_image
+    from benchmark.cameras import camera_from_dict
+    from metricscenes.radiance import RadianceLayer, SpectralScene
+
+    optics_spec = {"f_number": 2.2, "focal_length_mm": 5.0}
+    if distortion:
+        optics_spec.update(distortion_k1=distortion[0], distortion_k2=distortion[1])
+    cam = camera_from_dict({"name": "values", "optics": optics_spec,
+                            "sensor": {"pixel_um": 2.8, "active_width_mm": 0.224, "active_height_mm": 0.168}})
+    cube = np.random.default_rng(5).random((120, 200, 31), dtype=np.float32) * 0.05
+    scene = SpectralScene(layers=(RadianceLayer(cube, REFERENCE_EXTENT),))
+    oi = optical_image(scene, cam)
+    assert oi.irradiance.shape == (cam.height_px, cam.width_px, 31) and oi.pixel_um == cam.pixel_um
+    plain = sensor.signal_from_irradiance(oi.irradiance, oi.wavelengths_nm, cam.sensor)
+    fused = electron_rate(scene, cam)
+    inner = (slice(None), slice(12, -12), slice(12, -12))  # the two paths pad the PSF differently
+    np.testing.assert_allclose(fused[inner], plain[inner], rtol=0, atol=3e-4 * plain.max())
+
+
 def test_in_place_sensor_equals_the_written_out_noise_chain():
     spec = load_camera("cam10").sensor
     rate = np.random.default_rng(4).random((32, 48), dtype=np.float32) * 4e5

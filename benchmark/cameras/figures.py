@@ -33,7 +33,7 @@ def reference_signal_e_per_s(camera: CameraSpec) -> float:
     and sensor response on a uniform scene, diffraction off (it does not change a
     uniform field)."""
     from benchmark.camera import electron_rate
-    from benchmark.isp import illuminant_spectrum
+    from benchmark.calibration import illuminant_spectrum
     from metricscenes.geometry import REFERENCE_EXTENT
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.radiance import SpectralScene
