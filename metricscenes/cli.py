@@ -42,11 +42,16 @@ def progress_bar(console: Console, disable: bool = False):
 
 
 def _user_errors():
+    from metricscenes.backends import BackendError
     from metricscenes.manifest import ManifestError
     from metricscenes.render import RenderError
     from metricscenes.store import CollectionError
 
-    return (ManifestError, CollectionError, RenderError)
+    return (ManifestError, CollectionError, RenderError, BackendError)
+
+
+SCHEDULER_HELP = ("run on dask: 'local' (a LocalCluster of --workers processes) or tcp://HOST:PORT of a running "
+                  "scheduler, whose workers see --out at the same path (docs/performance.md)")
 
 
 @app.command()
@@ -55,6 +60,7 @@ def generate(
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="collection folder to write")] = None,
     workers: Annotated[int, typer.Option(min=1, help="render processes")] = 1,
     threads: Annotated[Optional[int], typer.Option(min=1, help="render threads per process")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="print the plan, render nothing")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
 ) -> None:
@@ -76,9 +82,9 @@ def generate(
         from metricscenes.generate import check_before_writing
         from metricscenes.generate import generate as run_generate
 
-        # Before any output: --out, the memory estimate, the variant (LLVM can abort the
-        # process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
-        check_before_writing(m, out, workers)
+        # Before any output: --out, --scheduler, the memory estimate, the variant (LLVM can abort
+        # the process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
+        check_before_writing(m, out, workers, scheduler)
 
         started = time.perf_counter()
         with progress_bar(err, disable=as_json) as bar:
@@ -87,7 +93,7 @@ def generate(
             def progress(done: int, total: int, key: str | None) -> None:
                 bar.update(task, completed=done, total=total, description=f"rendering {key or m.name}")
 
-            run_generate(m, out, workers=workers, threads=threads, progress=progress,
+            run_generate(m, out, workers=workers, threads=threads, scheduler=scheduler, progress=progress,
                          notice=lambda line: err.print(line, highlight=False, soft_wrap=True))
         seconds = time.perf_counter() - started
         if as_json:

@@ -18,15 +18,15 @@ import json
 import math
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from contextlib import closing
 from dataclasses import asdict, dataclass
-from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from metricscenes import __version__
+from metricscenes.backends import check_scheduler, is_remote, map_units, threads_per_unit
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco_groundtruth, mask_box_tan
 from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
@@ -225,14 +225,17 @@ def check_out_dir(out_dir: str | Path) -> Path:
     return root
 
 
-def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int = 1) -> Path:
+def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int = 1,
+                         scheduler: str | None = None) -> Path:
     """Everything that can refuse a run without rendering, before any output exists: the
-    ``--out`` folder, the memory the render needs, the Mitsuba variant."""
+    ``--out`` folder, the ``--scheduler``, the memory the render needs, the Mitsuba variant."""
     from metricscenes.manifest import check_memory
     from metricscenes.render import check_variant
 
     root = check_out_dir(out_dir)
-    check_memory(manifest, workers, source=f"manifest {manifest.name}")
+    check_scheduler(scheduler)
+    if not is_remote(scheduler):  # a running cluster's workers have their own machines' memory
+        check_memory(manifest, workers, source=f"manifest {manifest.name}")
     check_variant(manifest.render.variant)  # an LLVM variant can abort the process, CUDA needs a GPU
     return root
 
@@ -258,31 +261,36 @@ def _prepare(root: Path, manifest: Manifest) -> None:
 
 
 def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threads: int | None = None,
-             progress=None, notice=None) -> Path:
+             scheduler: str | None = None, progress=None, notice=None) -> Path:
     """Render ``manifest`` into ``out_dir`` (resuming what is already done, repairing
     what is damaged).
 
     ``workers`` processes render units in parallel; each uses ``threads`` render
-    threads (default: the CPU count divided by the workers). ``progress`` is an
+    threads (default: the CPU count divided by the workers). ``scheduler`` runs them on
+    dask instead (:mod:`metricscenes.backends`): ``local`` starts a LocalCluster of
+    ``workers`` processes, ``tcp://HOST:PORT`` uses that scheduler's cluster (whose
+    workers must see ``out_dir`` at the same path; ``threads`` default: each worker's
+    CPUs). The bytes do not depend on any of these. ``progress`` is an
     optional callable ``(done, total, unit_key)``; ``notice`` an optional callable that
     gets one line per finished unit found damaged (it is rendered again) and one when a
     stale lock is taken over.
 
     Before anything is created, :func:`check_before_writing` refuses a bad ``out_dir``, a
-    render that would not fit in memory and a Mitsuba variant that cannot run here; while
-    it writes, ``generate`` holds ``out_dir/generate.lock`` (:mod:`metricscenes.lock`), so a
-    second writer on the same folder is refused.
+    scheduler that cannot be used, a render that would not fit in memory and a Mitsuba
+    variant that cannot run here; while it writes, ``generate`` holds ``out_dir/generate.lock``
+    (:mod:`metricscenes.lock`), so a second writer on the same folder is refused.
     """
     from metricscenes.lock import collection_lock
 
-    root = check_before_writing(manifest, out_dir, workers)
+    root = check_before_writing(manifest, out_dir, workers, scheduler)
     root.mkdir(parents=True, exist_ok=True)
     with collection_lock(root, notice=notice):  # one writer at a time; released on errors too
-        _generate(manifest, root, workers, threads, progress, notice)
+        _generate(manifest, root, workers, threads, scheduler, progress, notice)
     return root
 
 
-def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None, progress, notice) -> None:
+def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None, scheduler: str | None,
+              progress, notice) -> None:
     import zarr
 
     _prepare(root, manifest)
@@ -297,44 +305,21 @@ def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None,
             if notice:
                 notice(f"rendering {key} again: {problem}")
     todo = [u for u in units if records[u.key] is None]
-    threads = threads or max(1, (os.cpu_count() or 1) // max(1, workers))
+    threads = threads_per_unit(threads, workers, scheduler)
     manifest_json = manifest.model_dump(mode="json")
     done = len(units) - len(todo)
     if progress:
         progress(done, len(units), None)
-
-    def finish(record: dict) -> None:
-        nonlocal done
-        write_atomic(_progress_path(root, record["unit"]), json.dumps(record, indent=1, sort_keys=True))
-        records[record["unit"]] = record
-        done += 1
-        if progress:
-            progress(done, len(units), record["unit"])
-
-    if workers <= 1:
-        for u in todo:
-            finish(render_unit(manifest_json, u, str(root), threads))
-    else:
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
-            futures = [pool.submit(render_unit, manifest_json, u, str(root), threads) for u in todo]
-            for f in futures:
-                finish(f.result())
+    # Units finish in any order; each record is written here, by the client, as it arrives.
+    jobs = [(manifest_json, u, str(root), threads) for u in todo]
+    with closing(map_units(render_unit, jobs, workers=workers, scheduler=scheduler)) as finished:
+        for record in finished:
+            write_atomic(_progress_path(root, record["unit"]), json.dumps(record, indent=1, sort_keys=True))
+            records[record["unit"]] = record
+            done += 1
+            if progress:
+                progress(done, len(units), record["unit"])
     _finalize(root, manifest, scenes, records)
-
-
-def die_with_parent(parent_pid: int) -> None:
-    """Worker initializer: on Linux, ask the kernel to SIGTERM this worker when its parent
-    dies (a killed ``generate`` otherwise leaves its workers rendering, ~300 MB each),
-    and leave at once if the parent died before this worker got here."""
-    import ctypes
-    import signal
-    import sys
-
-    if sys.platform.startswith("linux"):
-        PR_SET_PDEATHSIG = 1
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
-    if os.getppid() != parent_pid:
-        os._exit(1)
 
 
 def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, dict]) -> None:

@@ -1,0 +1,99 @@
+"""Backends (issue 11, point 3): `generate` writes the same bytes in this process, on a
+process pool and on a dask LocalCluster; a ``--scheduler`` that cannot be used is one line
+before anything is written."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from conftest import SMOKE_MANIFEST
+from metricscenes import backends
+from metricscenes.backends import BackendError, check_scheduler, map_units
+
+# Two environments (the bootstrap's minimum) at two distances, a 96 x 54 grid, daylight only:
+# 6 units of about half a second, so that three renders and two sweeps stay short.
+TINY = {**yaml.safe_load(SMOKE_MANIFEST.read_text()), "name": "tiny", "environments": 2, "distances_m": [50, 150],
+        "reference_grid": {"width_px": 96, "height_px": 54},
+        "render": {"plate_spp": 4, "inset_spp": 4, "inset_pixel_mrad": 0.5, "inset_max_px": 64, "max_depth": 3},
+        "light_groups": ["sky_day"], "conditions": {"day": {"sky_day": 1.0}}}
+del TINY["illuminance_sweep"]
+
+
+@pytest.fixture(scope="module")
+def tiny_manifest_file(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("tiny") / "tiny.yaml"
+    path.write_text(yaml.safe_dump(TINY, sort_keys=False))
+    return path
+
+
+@pytest.fixture(scope="module")
+def serial_collection(tiny_manifest_file, tmp_path_factory) -> Path:
+    """The tiny collection rendered in this process (``--workers 1``)."""
+    from metricscenes.generate import generate
+    from metricscenes.manifest import load_manifest
+
+    return generate(load_manifest(tiny_manifest_file), tmp_path_factory.mktemp("serial") / "c", workers=1)
+
+
+# --- generate ------------------------------------------------------------------------------
+@pytest.mark.slow
+@pytest.mark.parametrize("options", [["--workers", "2"], ["--scheduler", "local", "--workers", "2"]],
+                         ids=["process-pool", "dask-local"])
+def test_generate_bytes_do_not_depend_on_the_backend(serial_collection, tiny_manifest_file, tmp_path, options):
+    from metricscenes.cli import app
+
+    out = tmp_path / "c"
+    result = CliRunner().invoke(app, ["generate", "--manifest", str(tiny_manifest_file), "--out", str(out), *options])
+    assert result.exit_code == 0, result.output
+    for name in ("manifest.resolved.yaml", "groundtruth.json"):  # every array's sha256, the boxes, the variant
+        assert (out / name).read_bytes() == (serial_collection / name).read_bytes(), name
+
+
+# --- the backends themselves ---------------------------------------------------------------
+def test_map_units_gives_every_result_whatever_the_backend():
+    units = [(2, n) for n in range(5)]
+    assert list(map_units(pow, units)) == [1, 2, 4, 8, 16]  # in this process: in order
+    assert sorted(map_units(pow, units, workers=2)) == [1, 2, 4, 8, 16]  # as they finish
+    with pytest.raises(ValueError, match="invalid literal"):  # a unit's error, raised in the client
+        list(map_units(int, [("12",), ("twelve",)], workers=2))
+
+
+@pytest.mark.parametrize("address", ["tcp://example.org", "http://example.org:8786", "tcp://host:99999", "tcp://:8786",
+                                     "locale", ""])
+def test_a_malformed_scheduler_is_one_line(address):
+    with pytest.raises(BackendError, match="expected 'local' or a dask scheduler address") as refused:
+        check_scheduler(address)
+    assert "\n" not in str(refused.value)
+
+
+def test_missing_dask_is_one_line(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(BackendError, match=r"pip install 'metricscenes\[dask\]'"):
+        check_scheduler("local")
+
+
+def _closed_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_unreachable_scheduler_is_one_line_before_any_output(tmp_path, monkeypatch):
+    from metricscenes.cli import app
+
+    monkeypatch.setattr(backends, "CONNECT_TIMEOUT_S", 0.5)
+    address = f"tcp://127.0.0.1:{_closed_port()}"
+    out = tmp_path / "c"
+    result = CliRunner().invoke(app, ["generate", "--manifest", str(SMOKE_MANIFEST), "--out", str(out),
+                                      "--scheduler", address])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: ") and f"{address}: no dask scheduler answers" in lines[0]
+    assert not out.exists()
