@@ -1,9 +1,11 @@
-"""Backends (issue 11, point 3): `generate` writes the same bytes in this process, on a
-process pool and on a dask LocalCluster; a ``--scheduler`` that cannot be used is one line
+"""Backends and the render variant (issue 11, points 3-4): `generate` writes the same bytes
+in this process, on a process pool and on a dask LocalCluster; ``render.variant: auto`` is
+resolved, recorded and kept on resume; a ``--scheduler`` that cannot be used is one line
 before anything is written."""
 
 from __future__ import annotations
 
+import shutil
 import sys
 from pathlib import Path
 
@@ -19,9 +21,16 @@ from metricscenes.backends import BackendError, check_scheduler, map_units
 # 6 units of about half a second, so that three renders and two sweeps stay short.
 TINY = {**yaml.safe_load(SMOKE_MANIFEST.read_text()), "name": "tiny", "environments": 2, "distances_m": [50, 150],
         "reference_grid": {"width_px": 96, "height_px": 54},
-        "render": {"plate_spp": 4, "inset_spp": 4, "inset_pixel_mrad": 0.5, "inset_max_px": 64, "max_depth": 3},
+        "render": {"plate_spp": 4, "inset_spp": 4, "inset_pixel_mrad": 0.5, "inset_max_px": 64, "max_depth": 3,
+                   "variant": "auto"},
         "light_groups": ["sky_day"], "conditions": {"day": {"sky_day": 1.0}}}
 del TINY["illuminance_sweep"]
+
+
+def _cuda_usable() -> bool:
+    from metricscenes.render import resolve_variant
+
+    return resolve_variant("auto") != "scalar_spectral"
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +61,39 @@ def test_generate_bytes_do_not_depend_on_the_backend(serial_collection, tiny_man
     assert result.exit_code == 0, result.output
     for name in ("manifest.resolved.yaml", "groundtruth.json"):  # every array's sha256, the boxes, the variant
         assert (out / name).read_bytes() == (serial_collection / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_auto_variant_is_resolved_recorded_and_kept_on_resume(serial_collection, tmp_path):
+    from metricscenes.generate import generate
+    from metricscenes.manifest import parse_manifest
+    from metricscenes.store import CollectionError
+
+    resolved = yaml.safe_load((serial_collection / "manifest.resolved.yaml").read_text())
+    assert resolved["manifest"]["render"]["variant"] == "auto"
+    if not _cuda_usable():
+        assert resolved["render_variant"] == "scalar_spectral"
+    assert (serial_collection / "progress" / "render_variant").read_text().strip() == resolved["render_variant"]
+    # The same manifest resumed where `auto` means another variant: refused, nothing touched.
+    copy = shutil.copytree(serial_collection, tmp_path / "c")
+    (copy / "progress" / "render_variant").write_text("llvm_ad_spectral\n")
+    before = {p: p.read_bytes() for p in sorted(copy.rglob("*")) if p.is_file()}
+    with pytest.raises(CollectionError, match="rendered with Mitsuba variant llvm_ad_spectral") as refused:
+        generate(parse_manifest(TINY), copy)
+    assert "\n" not in str(refused.value)
+    assert {p: p.read_bytes() for p in sorted(copy.rglob("*")) if p.is_file()} == before
+
+
+def test_auto_variant_is_a_value_not_the_default():
+    """(The default stays scalar_spectral: it is part of every manifest's sha256, which
+    protocols.yaml pins; tests/test_leaderboard_submit.py checks those hashes.)"""
+    from metricscenes.manifest import parse_manifest
+    from metricscenes.render import resolve_variant
+
+    assert parse_manifest(TINY).render.variant == "auto"
+    default = {**TINY, "render": {k: v for k, v in TINY["render"].items() if k != "variant"}}
+    assert parse_manifest(default).render.variant == "scalar_spectral"
+    assert resolve_variant("auto") == ("cuda_ad_spectral" if _cuda_usable() else "scalar_spectral")
 
 
 # --- the backends themselves ---------------------------------------------------------------
