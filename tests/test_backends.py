@@ -1,10 +1,11 @@
-"""Backends and the render variant (issue 11, points 3-4): `generate` writes the same bytes
-in this process, on a process pool and on a dask LocalCluster; ``render.variant: auto`` is
-resolved, recorded and kept on resume; a ``--scheduler`` that cannot be used is one line
-before anything is written."""
+"""Backends and the render variant (issue 11, points 3-4): `generate` and `benchmark sweep`
+write the same bytes in this process, on a process pool and on a dask LocalCluster;
+``render.variant: auto`` is resolved, recorded and kept on resume; a ``--scheduler`` that
+cannot be used is one line before anything is written."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -13,9 +14,10 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from conftest import SMOKE_MANIFEST
+from conftest import SMOKE_MANIFEST, model_dir, require_model
 from metricscenes import backends
 from metricscenes.backends import BackendError, check_scheduler, map_units
+from test_sweep_cli import fakes  # noqa: F401 (a fixture)
 
 # Two environments (the bootstrap's minimum) at two distances, a 96 x 54 grid, daylight only:
 # 6 units of about half a second, so that three renders and two sweeps stay short.
@@ -96,6 +98,42 @@ def test_auto_variant_is_a_value_not_the_default():
     assert resolve_variant("auto") == ("cuda_ad_spectral" if _cuda_usable() else "scalar_spectral")
 
 
+# --- benchmark sweep -----------------------------------------------------------------------
+def _sweep_files(folder: Path) -> dict[str, bytes]:
+    """Every file of a sweep folder, results.json without its wall-clock ``timing_s``."""
+    files = {}
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        data = path.read_bytes()
+        if path.name == "results.json":
+            results = json.loads(data)
+            results.pop("timing_s")
+            data = json.dumps(results).encode()
+        files[str(path.relative_to(folder))] = data
+    return files
+
+
+@pytest.mark.slow
+def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.cameras import load_camera
+    from benchmark.detectors import load_detector
+    from benchmark.sweep import sweep
+
+    cameras = []
+    for name, f_number, pixel_um in (("small-a", 2.0, 11.2), ("small-b", 4.0, 8.4)):  # 240 x 135 and 320 x 180 px
+        spec = tmp_path / f"{name}.yaml"
+        spec.write_text(f"name: {name}\noptics: {{f_number: {f_number}}}\nsensor: {{pixel_um: {pixel_um}}}\n")
+        cameras.append(load_camera(spec))
+    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
+    options = dict(n_resamples=20, mtf_source="analytic")
+    serial = sweep(serial_collection, cameras, ["day"], detector, tmp_path / "serial", **options)
+    pooled = sweep(serial_collection, cameras, ["day"], detector, tmp_path / "pooled", workers=2, **options)
+    assert serial.equals(pooled)
+    files = _sweep_files(tmp_path / "serial")
+    assert any(name.endswith(".png") for name in files) and "runs/small-b-day/od50.json" in files
+    assert _sweep_files(tmp_path / "pooled") == files
+
+
 # --- the backends themselves ---------------------------------------------------------------
 def test_map_units_gives_every_result_whatever_the_backend():
     units = [(2, n) for n in range(5)]
@@ -139,3 +177,16 @@ def test_unreachable_scheduler_is_one_line_before_any_output(tmp_path, monkeypat
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("error: ") and f"{address}: no dask scheduler answers" in lines[0]
     assert not out.exists()
+
+
+def test_sweep_refuses_an_unusable_scheduler_in_one_line(fakes, monkeypatch):  # noqa: F811
+    from benchmark.cli import app
+
+    monkeypatch.setattr(backends, "CONNECT_TIMEOUT_S", 0.5)
+    for address, message in ((f"tcp://127.0.0.1:{_closed_port()}", "no dask scheduler answers"),
+                             ("tcp://nowhere", "expected 'local'")):
+        result = CliRunner().invoke(app, ["sweep", "--collection", str(fakes), "--cameras", "cam01",
+                                          "--out", str(fakes / "sw"), "--scheduler", address])
+        assert result.exit_code == 2 and "Traceback" not in result.output
+        assert len([line for line in result.output.splitlines() if line.strip()]) == 1 and message in result.output
+        assert not (fakes / "sw").exists()
