@@ -14,7 +14,7 @@ from benchmark.cli_cameras import app as cameras_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark import cli_detect, cli_leaderboard, compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
-from metricscenes.cli_support import fail, progress_bar
+from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
@@ -115,6 +115,8 @@ def sweep(
     environments: Annotated[Optional[str], typer.Option(help=SUBSET_ENV_HELP)] = None,
     distances: Annotated[Optional[str], typer.Option(help=SUBSET_DIST_HELP)] = None,
     class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
+    workers: Annotated[int, typer.Option(min=1, help="processes running camera × condition runs in parallel")] = 1,
+    scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
     from benchmark import sweep as sweep_module
@@ -122,6 +124,7 @@ def sweep(
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.exposure import format_exposure, parse_exposure
     from benchmark.run import check_out_dir, subset_collection
+    from metricscenes.backends import BackendError, runs_in_process, threads_per_unit
     from metricscenes.store import Collection, CollectionError
 
     try:
@@ -137,6 +140,8 @@ def sweep(
                 fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
         if mtf_source not in sweep_module.MTF50_SOURCES:
             fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF50_SOURCES)}, got {mtf_source!r}")
+        if not runs_in_process(workers, scheduler):  # each worker loads the detector again, with its share of the CPUs
+            threads = threads_per_unit(threads, workers, scheduler)
         detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
@@ -150,8 +155,9 @@ def sweep(
                 bar.update(task, completed=done, total=total, description=label)
 
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
-                               progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy)
-    except (ValueError, DetectorError, CollectionError, OSError) as exc:
+                               progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy,
+                               workers=workers, scheduler=scheduler)
+    except (ValueError, DetectorError, CollectionError, BackendError, OSError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     _, od50_table = sweep_module.load_sweep(out)
     title = f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments"

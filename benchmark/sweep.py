@@ -9,7 +9,10 @@ and input size, collection manifest sha256, seed — is reused, not recomputed.
 A collection subset (:class:`benchmark.run.CollectionSubset`, ``--environments`` /
 ``--distances``) adds ``subset`` to the key and ``+subset-<hash>`` to the folder name.
 ``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
-only its missing (or stale) runs.
+only its missing (or stale) runs. Those runs may go to worker processes or a dask cluster
+(``workers``, ``scheduler``: :mod:`metricscenes.backends`); each writes only its own run
+folder, and the sweep's tables are written here, in camera × condition order, so their bytes
+do not depend on where the runs ran.
 
 Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
 
@@ -30,6 +33,7 @@ import json
 import math
 import os
 import warnings
+from contextlib import closing
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterable
 
@@ -144,10 +148,23 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
     return _json_safe(out)
 
 
+def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
+                backend: str, n_resamples: int, progress=None) -> tuple[str, str, dict]:
+    """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
+    backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
+    other unit touches. Returns (camera name, condition, results)."""
+    from benchmark import run as run_module
+
+    results = run_module.run_camera(collection, camera, condition, detector, run_dir, seed=seed,
+                                    save_images=save_images, backend=backend, progress=progress)
+    run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
+    return camera.name, condition, results
+
+
 def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
           n_resamples: int = BOOTSTRAP_RESAMPLES, progress: Progress | None = None, mtf_source: str = "measured",
           backend: str = "faster-coco-eval", save_images: bool = True,
-          exposure: ExposureSpec | None = None) -> pd.DataFrame:
+          exposure: ExposureSpec | None = None, workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
     """Run every camera × condition (reusing cached runs); write and return the AP table.
 
     Args:
@@ -159,11 +176,16 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         seed: sensor-noise seed of every run and the bootstrap seed.
         n_resamples: bootstrap resamples of OD50 (over environments).
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
-            run advances by all its scenes at once.
+            run advances by all its scenes at once (so does every run on a pool or cluster).
         mtf_source: ``measured`` | ``analytic`` | ``published_group`` (see :func:`benchmark.mtf.camera_mtf50`).
         exposure: an :class:`ExposureSpec` replacing every camera's exposure block (None:
             each camera's own); it changes the spec sha256 (the cache key) and tags the
             folders of the runs it changed (:func:`run_name`).
+        workers, scheduler: where the runs that are not cached go
+            (:func:`metricscenes.backends.map_units`): one after another here (default),
+            ``workers`` processes, or dask (``scheduler`` ``local`` or ``tcp://HOST:PORT``).
+            The detector is pickled as what builds it and loaded again in each worker. The
+            outputs do not depend on these (``results.json`` ``timing_s`` aside).
 
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
@@ -172,6 +194,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.camera import camera_window
     from benchmark.cameras import load_camera
     from benchmark.exposure import exposure_tag, format_exposure, with_exposure
+    from metricscenes.backends import check_scheduler, map_units, runs_in_process
     from metricscenes.store import Collection
 
     if mtf_source not in MTF50_SOURCES:
@@ -201,11 +224,43 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         camera_window(camera, field)
         for condition in conditions:
             run_name(camera.name, condition, tags[camera.name])
+    check_scheduler(scheduler)
     out_dir = run_module.check_out_dir(out_dir)
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
     n_scenes = len(collection.scenes())
     total, done = n_scenes * len(cameras) * len(conditions), 0
+    run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
+                for camera in cameras for condition in conditions}
+    results: dict[tuple[str, str], dict] = {}
+    todo = []
+    for camera in cameras:
+        for condition in conditions:
+            cached = cached_results(run_dirs[camera.name, condition], run_key(camera, condition, detector, collection, seed))
+            if cached is None:
+                todo.append((camera, condition))
+                continue
+            results[camera.name, condition] = cached
+            done += n_scenes
+            if progress:
+                progress(done, total, f"{camera.name} · {condition}")
+    reused = set(results)
+
+    in_process = runs_in_process(workers, scheduler)
+
+    def scene_progress(label: str):
+        # (a run computed here reports each scene; ``done`` is read when called: the runs before it)
+        return (lambda d, t: progress(done + d, total, label)) if progress and in_process else None
+
+    jobs = [(collection, camera, condition, detector, run_dirs[camera.name, condition], seed, save_images, backend,
+             n_resamples, scene_progress(f"{camera.name} · {condition}")) for camera, condition in todo]
+    with closing(map_units(compute_run, jobs, workers=workers, scheduler=scheduler)) as finished:
+        for camera_name, condition, run_results in finished:  # in the order they finish
+            results[camera_name, condition] = run_results
+            done += n_scenes
+            if progress:
+                progress(done, total, f"{camera_name} · {condition}")
+
     rows, od50_rows, runs = [], [], []
     for camera in cameras:
         mtf50, source = camera_mtf50(camera, mtf_source)
@@ -213,22 +268,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
                  "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
         for condition in conditions:
-            label = f"{camera.name} · {condition}"
-            run_dir = out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
-            results = cached_results(run_dir, run_key(camera, condition, detector, collection, seed))
-            reused = results is not None
-            if results is None:
-                base = done
-                results = run_module.run_camera(
-                    collection, camera, condition, detector, run_dir, seed=seed, save_images=save_images,
-                    backend=backend,
-                    progress=(lambda d, t, base=base, label=label: progress(base + d, total, label)) if progress else None)
-            done += n_scenes
-            if progress:
-                progress(done, total, label)
+            run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
             runs.append({"camera": camera.name, "condition": condition, "path": str(run_dir.relative_to(out_dir)),
-                         "reused": reused})
-            for r in results["per_distance"]:
+                         "reused": (camera.name, condition) in reused})
+            for r in run_results["per_distance"]:
                 rows.append({**ident, "condition": condition, "distance_m": r["distance_m"], "ap": r["ap"],
                              "ap50": r["ap50"], "n_images": r["n_images"]})
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
@@ -236,8 +279,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             od50_rows.append({**ident, "condition": condition, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
                               "ci95_lo_m": _num(lo), "ci95_hi_m": _num(hi), "n_resamples": boot["n_resamples"],
                               "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"],
-                              "censored": od50_censoring([r["distance_m"] for r in results["per_distance"]],
-                                                         [r["ap"] for r in results["per_distance"]])[0]})
+                              "censored": od50_censoring([r["distance_m"] for r in run_results["per_distance"]],
+                                                         [r["ap"] for r in run_results["per_distance"]])[0]})
 
     table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
     od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from metricscenes import __version__
-from metricscenes.cli_support import fail, progress_bar
+from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="Seeded metric driving scenes rendered as spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).")
@@ -22,11 +22,12 @@ err = Console(stderr=True)
 
 
 def _user_errors():
+    from metricscenes.backends import BackendError
     from metricscenes.manifest import ManifestError
     from metricscenes.render import RenderError
     from metricscenes.store import CollectionError
 
-    return (ManifestError, CollectionError, RenderError)
+    return (ManifestError, CollectionError, RenderError, BackendError)
 
 
 @app.command()
@@ -35,6 +36,7 @@ def generate(
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="collection folder to write")] = None,
     workers: Annotated[int, typer.Option(min=1, help="render processes")] = 1,
     threads: Annotated[Optional[int], typer.Option(min=1, help="render threads per process")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="print the plan, render nothing")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
 ) -> None:
@@ -56,9 +58,9 @@ def generate(
         from metricscenes.generate import check_before_writing
         from metricscenes.generate import generate as run_generate
 
-        # Before any output: --out, the memory estimate, the variant (LLVM can abort the
-        # process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
-        check_before_writing(m, out, workers)
+        # Before any output: --out, --scheduler, the memory estimate, the variant (LLVM can abort
+        # the process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
+        check_before_writing(m, out, workers, scheduler)
 
         started = time.perf_counter()
         with progress_bar(err, disable=as_json) as bar:
@@ -67,7 +69,7 @@ def generate(
             def progress(done: int, total: int, key: str | None) -> None:
                 bar.update(task, completed=done, total=total, description=f"rendering {key or m.name}")
 
-            run_generate(m, out, workers=workers, threads=threads, progress=progress,
+            run_generate(m, out, workers=workers, threads=threads, scheduler=scheduler, progress=progress,
                          notice=lambda line: err.print(line, highlight=False, soft_wrap=True))
         seconds = time.perf_counter() - started
         if as_json:
@@ -109,7 +111,9 @@ def info(
     size = sum(p.stat().st_size for p in (collection / "radiance.zarr").rglob("*") if p.is_file())
     summary = {
         "name": c.name, "protocol": c.protocol, "manifest_sha256": c.manifest_sha256,
-        "package_version": c.resolved["package_version"], "scenes": len(scenes),
+        "package_version": c.resolved["package_version"],
+        # (collections made before render.variant: auto record none: their manifest's variant rendered them)
+        "render_variant": c.resolved.get("render_variant", c.manifest["render"]["variant"]), "scenes": len(scenes),
         "environments": len({s.environment_id for s in scenes}),
         "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.condition_names,
         "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved["arrays"]),

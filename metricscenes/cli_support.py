@@ -39,3 +39,8 @@ def progress_bar(console: Console, disable: bool = False):
         except BaseException:
             bar.live.transient = True
             raise
+
+
+SCHEDULER_HELP = ("run on dask: 'local' (a LocalCluster of --workers processes) or tcp://HOST:PORT of a running "
+                  "scheduler, whose workers see --out at the same path (docs/performance.md)")
+"""``--scheduler`` of ``metricscenes generate`` and ``benchmark sweep``."""

@@ -18,18 +18,18 @@ import json
 import math
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from contextlib import closing
 from dataclasses import asdict, dataclass
-from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from metricscenes import __version__
+from metricscenes.backends import check_scheduler, is_remote, map_units, threads_per_unit
 from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco_groundtruth, mask_box_tan
-from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
+from metricscenes.manifest import AUTO_VARIANT, PLATE_LIGHT_GROUPS, Manifest
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.store import (
     GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, read_checked,
@@ -40,6 +40,8 @@ from metricscenes.store import (
 # the sides and top catch reflections and antialiasing; the bottom catches the shadow
 # and the lamps' footprint on the road.
 INSET_MARGIN = {"left": 0.3, "right": 0.3, "top": 0.2, "bottom": 0.6}
+VARIANT_STAMP = "render_variant"
+"""File under ``progress/`` naming the Mitsuba variant that renders the collection."""
 
 
 @dataclass(frozen=True)
@@ -84,14 +86,15 @@ def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
     return k, cx0, cy0, cx1 - cx0, cy1 - cy0
 
 
-def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None) -> dict:
-    """Render and write one unit (runs in a worker process); return its progress record."""
+def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None, variant: str) -> dict:
+    """Render and write one unit (runs in a worker process) with the Mitsuba ``variant``
+    (the manifest's, ``auto`` resolved); return its progress record."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.render import Film, illuminance_meter, render_radiance, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
-    use_variant(manifest.render.variant, threads)
+    use_variant(variant, threads)
     root = Path(out_dir)
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     field = manifest.reference_grid.field
@@ -226,31 +229,66 @@ def check_out_dir(out_dir: str | Path) -> Path:
     return root
 
 
-def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int = 1) -> Path:
+def render_variant(manifest: Manifest, scheduler: str | None = None) -> str:
+    """The Mitsuba variant the units will render with, checked where they will run
+    (:class:`~metricscenes.render.RenderError`, one line, if it cannot run there): the
+    manifest's ``render.variant``, ``auto`` resolved (:func:`metricscenes.render.resolve_variant`)."""
+    from metricscenes.render import resolve_variant
+
+    if is_remote(scheduler):  # the cluster's machines render, and this one may have no GPU: ask one of them
+        with closing(map_units(resolve_variant, [(manifest.render.variant,)], scheduler=scheduler)) as answer:
+            return next(answer)
+    return resolve_variant(manifest.render.variant)
+
+
+def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int = 1,
+                         scheduler: str | None = None) -> Path:
     """Everything that can refuse a run without rendering, before any output exists: the
-    ``--out`` folder, the memory the render needs, the Mitsuba variant."""
+    ``--out`` folder, the ``--scheduler``, the memory the render needs, the Mitsuba variant."""
     from metricscenes.manifest import check_memory
-    from metricscenes.render import check_variant
 
     root = check_out_dir(out_dir)
-    check_memory(manifest, workers, source=f"manifest {manifest.name}")
-    check_variant(manifest.render.variant)  # an LLVM variant can abort the process, CUDA needs a GPU
+    check_scheduler(scheduler)
+    if not is_remote(scheduler):  # a running cluster's workers have their own machines' memory
+        check_memory(manifest, workers, source=f"manifest {manifest.name}")
+    render_variant(manifest, scheduler)  # an LLVM variant can abort the process, CUDA needs a GPU
     return root
 
 
-def _prepare(root: Path, manifest: Manifest) -> None:
+def _has_finished_work(root: Path) -> bool:
+    return any((root / PROGRESS_DIR).glob("*.json")) or (root / RESOLVED_MANIFEST_FILE).exists()
+
+
+def _recorded_variant(root: Path, manifest: Manifest) -> str | None:
+    """The variant that rendered the units already in ``root`` (None: unknown)."""
+    try:
+        return (root / PROGRESS_DIR / VARIANT_STAMP).read_text().strip()
+    except OSError:  # collections made before the stamp could only use the variant their manifest names
+        return None if manifest.render.variant == AUTO_VARIANT else manifest.render.variant
+
+
+def _prepare(root: Path, manifest: Manifest, variant: str | None = None) -> None:
+    """Stamp ``root`` with the manifest's sha256 and the Mitsuba ``variant`` (default: the
+    manifest's, resolved here) and create the store, refusing (:class:`CollectionError`) a
+    folder whose finished units came from another manifest or another variant."""
     import zarr
 
+    from metricscenes.render import resolve_variant
+
+    variant = variant or resolve_variant(manifest.render.variant)
     (root / PROGRESS_DIR).mkdir(exist_ok=True)
     stamp = root / PROGRESS_DIR / "manifest_sha256"
-    if stamp.exists() and stamp.read_text().strip() != manifest.sha256():
-        finished = any((root / PROGRESS_DIR).glob("*.json")) or (root / RESOLVED_MANIFEST_FILE).exists()
-        if finished:
-            raise CollectionError(
-                f"{root}: holds a collection of another manifest; choose another --out or delete it"
-            )
-        # a run of another manifest that finished no unit (a render error): nothing to keep
+    finished = _has_finished_work(root)  # (a run that finished no unit, e.g. a render error, left nothing to keep)
+    if finished and stamp.exists() and stamp.read_text().strip() != manifest.sha256():
+        raise CollectionError(f"{root}: holds a collection of another manifest; choose another --out or delete it")
+    recorded = _recorded_variant(root, manifest)
+    if finished and recorded != variant:
+        # The same manifest with render.variant: auto, resumed on a machine that resolves it otherwise.
+        raise CollectionError(
+            f"{root}: rendered with Mitsuba variant {recorded or '(unknown)'}, this run would render with {variant} "
+            f"(render.variant: {manifest.render.variant}); finish it where it was started or choose another --out")
     write_atomic(stamp, manifest.sha256() + "\n")
+    write_atomic(root / PROGRESS_DIR / VARIANT_STAMP, variant + "\n")
     zroot = zarr.open_group(str(root / RADIANCE_STORE), mode="a")
     zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
                         "dimension_names": ["y", "x", "wavelength"]})
@@ -259,34 +297,40 @@ def _prepare(root: Path, manifest: Manifest) -> None:
 
 
 def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threads: int | None = None,
-             progress=None, notice=None) -> Path:
+             scheduler: str | None = None, progress=None, notice=None) -> Path:
     """Render ``manifest`` into ``out_dir`` (resuming what is already done, repairing
     what is damaged).
 
     ``workers`` processes render units in parallel; each uses ``threads`` render
-    threads (default: the CPU count divided by the workers). ``progress`` is an
+    threads (default: the CPU count divided by the workers). ``scheduler`` runs them on
+    dask instead (:mod:`metricscenes.backends`): ``local`` starts a LocalCluster of
+    ``workers`` processes, ``tcp://HOST:PORT`` uses that scheduler's cluster (whose
+    workers must see ``out_dir`` at the same path; ``threads`` default: each worker's
+    CPUs). The bytes do not depend on any of these. ``progress`` is an
     optional callable ``(done, total, unit_key)``; ``notice`` an optional callable that
     gets one line per finished unit found damaged (it is rendered again) and one when a
     stale lock is taken over.
 
     Before anything is created, :func:`check_before_writing` refuses a bad ``out_dir``, a
-    render that would not fit in memory and a Mitsuba variant that cannot run here; while
-    it writes, ``generate`` holds ``out_dir/generate.lock`` (:mod:`metricscenes.lock`), so a
-    second writer on the same folder is refused.
+    scheduler that cannot be used, a render that would not fit in memory and a Mitsuba
+    variant that cannot run here; while it writes, ``generate`` holds ``out_dir/generate.lock``
+    (:mod:`metricscenes.lock`), so a second writer on the same folder is refused.
     """
     from metricscenes.lock import collection_lock
 
-    root = check_before_writing(manifest, out_dir, workers)
+    root = check_before_writing(manifest, out_dir, workers, scheduler)
+    variant = render_variant(manifest, scheduler)
     root.mkdir(parents=True, exist_ok=True)
     with collection_lock(root, notice=notice):  # one writer at a time; released on errors too
-        _generate(manifest, root, workers, threads, progress, notice)
+        _generate(manifest, root, variant, workers, threads, scheduler, progress, notice)
     return root
 
 
-def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None, progress, notice) -> None:
+def _generate(manifest: Manifest, root: Path, variant: str, workers: int, threads: int | None,
+              scheduler: str | None, progress, notice) -> None:
     import zarr
 
-    _prepare(root, manifest)
+    _prepare(root, manifest, variant)
     scenes = plan_collection(manifest)
     units = plan_units(scenes)
     records = {u.key: _load_record(root, u.key) for u in units}
@@ -298,47 +342,24 @@ def _generate(manifest: Manifest, root: Path, workers: int, threads: int | None,
             if notice:
                 notice(f"rendering {key} again: {problem}")
     todo = [u for u in units if records[u.key] is None]
-    threads = threads or max(1, (os.cpu_count() or 1) // max(1, workers))
+    threads = threads_per_unit(threads, workers, scheduler)
     manifest_json = manifest.model_dump(mode="json")
     done = len(units) - len(todo)
     if progress:
         progress(done, len(units), None)
-
-    def finish(record: dict) -> None:
-        nonlocal done
-        write_atomic(_progress_path(root, record["unit"]), json.dumps(record, indent=1, sort_keys=True))
-        records[record["unit"]] = record
-        done += 1
-        if progress:
-            progress(done, len(units), record["unit"])
-
-    if workers <= 1:
-        for u in todo:
-            finish(render_unit(manifest_json, u, str(root), threads))
-    else:
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
-            futures = [pool.submit(render_unit, manifest_json, u, str(root), threads) for u in todo]
-            for f in futures:
-                finish(f.result())
-    _finalize(root, manifest, scenes, records)
+    # Units finish in any order; each record is written here, by the client, as it arrives.
+    jobs = [(manifest_json, u, str(root), threads, variant) for u in todo]
+    with closing(map_units(render_unit, jobs, workers=workers, scheduler=scheduler)) as finished:
+        for record in finished:
+            write_atomic(_progress_path(root, record["unit"]), json.dumps(record, indent=1, sort_keys=True))
+            records[record["unit"]] = record
+            done += 1
+            if progress:
+                progress(done, len(units), record["unit"])
+    _finalize(root, manifest, scenes, records, variant)
 
 
-def die_with_parent(parent_pid: int) -> None:
-    """Worker initializer: on Linux, ask the kernel to SIGTERM this worker when its parent
-    dies (a killed ``generate`` otherwise leaves its workers rendering, ~300 MB each),
-    and leave at once if the parent died before this worker got here."""
-    import ctypes
-    import signal
-    import sys
-
-    if sys.platform.startswith("linux"):
-        PR_SET_PDEATHSIG = 1
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
-    if os.getppid() != parent_pid:
-        os._exit(1)
-
-
-def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, dict]) -> None:
+def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, dict], variant: str) -> None:
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     images, boxes = [], []
     for s in scenes:
@@ -359,6 +380,7 @@ def _finalize(root: Path, manifest: Manifest, scenes: list[ScenePlan], records: 
         "package_version": __version__,
         "manifest_sha256": manifest.sha256(),
         "manifest": manifest.model_dump(mode="json"),
+        "render_variant": variant,  # the Mitsuba variant that rendered the arrays (render.variant: auto resolved)
         "arrays": arrays,
         # Horizontal illuminance at the camera (0, 0, 1.5 m) per environment and light group.
         # (sorted: a record read back from progress/ has sorted keys, one just rendered has not)

@@ -94,6 +94,10 @@ class ReferenceGrid(_Strict):
         return field_extent(self.hfov_deg, self.width_px, self.height_px)
 
 
+AUTO_VARIANT = "auto"
+"""``render.variant`` that lets the machine choose (:func:`metricscenes.render.resolve_variant`)."""
+
+
 class RenderSettings(_Strict):
     plate_spp: Int = Field(ge=1, le=65536, description="samples per pixel of plates")
     inset_spp: Int = Field(ge=1, le=65536, description="samples per pixel of insets")
@@ -102,7 +106,9 @@ class RenderSettings(_Strict):
     )
     inset_max_px: Int = Field(512, ge=32, le=8192, description="cap on an inset's longer side, pixels")
     max_depth: Int = Field(6, ge=2, le=64, description="path length limit of the path tracer")
-    variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral"] = "scalar_spectral"
+    # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
+    # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
+    variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
 
 
 _ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")

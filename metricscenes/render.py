@@ -5,7 +5,8 @@ the band-averaged radiance in the emitters' units, a ``box`` reconstruction filt
 (bit-identical results whatever the thread count) and a ``stratified`` sampler (less
 per-band noise). On CPU the ``scalar_spectral`` variant is as fast as LLVM for this
 film and needs no libLLVM (see docs/performance.md); the LLVM variants crash with the
-system's libllvm15 and are only used when asked for explicitly.
+system's libllvm15 and are only used when asked for explicitly. ``render.variant: auto``
+renders with ``cuda_ad_spectral`` where a CUDA device is usable (:func:`resolve_variant`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from metricscenes.geometry import CAMERA_HEIGHT_M, REFERENCE_EXTENT, TanExtent, 
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
 
 _active_variant: str | None = None
+CPU_VARIANT = "scalar_spectral"
+GPU_VARIANT = "cuda_ad_spectral"
 
 
 class RenderError(RuntimeError):
@@ -57,6 +60,39 @@ def check_variant(variant: str) -> None:
         raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
     if variant.startswith(("llvm", "cuda")):
         _probe_jit(variant)
+
+
+def resolve_variant(setting: str) -> str:
+    """The Mitsuba variant a ``render.variant`` setting means on this machine, checked
+    (:class:`RenderError` if it cannot render here): ``auto`` is ``cuda_ad_spectral`` where a
+    CUDA device renders 2x2 pixels, else ``scalar_spectral``; any other setting is itself."""
+    from metricscenes.manifest import AUTO_VARIANT
+
+    if setting != AUTO_VARIANT:
+        check_variant(setting)
+        return setting
+    if _cuda_driver_present():
+        try:
+            check_variant(GPU_VARIANT)
+            return GPU_VARIANT
+        except RenderError:
+            pass  # a driver without a usable device (or a Mitsuba without CUDA variants)
+    return CPU_VARIANT
+
+
+def _cuda_driver_present() -> bool:
+    """Whether the CUDA driver library loads (spares the probe's child process, ~2 s, on
+    machines without an NVIDIA driver)."""
+    import ctypes
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return True  # (other systems: let the probe decide)
+    try:
+        ctypes.CDLL("libcuda.so.1")
+    except OSError:
+        return False
+    return True
 
 
 @lru_cache(maxsize=None)

@@ -8,9 +8,12 @@ Layout of a collection folder::
       frames/<scene>/car_lights         (y, x, wavelength) float32, the car's lamps over the whole view
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
-    manifest.resolved.yaml              manifest as run, package version, sha256 of every array
-                                        (masks too), of groundtruth.json and of its own content
+    manifest.resolved.yaml              manifest as run, package version, the Mitsuba variant that
+                                        rendered it, sha256 of every array (masks too), of
+                                        groundtruth.json and of its own content
     progress/<unit>.json                one record per finished unit of work (resume)
+    progress/manifest_sha256            what the records were made from (a resume of another
+    progress/render_variant             manifest, or with another variant, is refused)
 
 Every array is one chunk written by one unit of work, so workers never share a file.
 Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)

@@ -10,9 +10,11 @@ REPO = Path(__file__).resolve().parents[1]
 
 # What `benchmark` may import from `metricscenes`: the store API (collections, their
 # ground truth on any grid), value types (manifests, tangent extents, spectral scenes), units
-# (wavelength grid, photometry), small shared helpers (files, CLI) and the version.
+# (wavelength grid, photometry), small shared helpers (files, CLI, the process-pool and
+# dask backends) and the version.
 PUBLIC = {"metricscenes", "metricscenes.store", "metricscenes.manifest", "metricscenes.geometry", "metricscenes.radiance",
-          "metricscenes.spectral", "metricscenes.photometry", "metricscenes.files", "metricscenes.cli_support"}
+          "metricscenes.spectral", "metricscenes.photometry", "metricscenes.files", "metricscenes.cli_support",
+          "metricscenes.backends"}
 
 
 def _imports(package: str) -> dict[str, set[str]]:

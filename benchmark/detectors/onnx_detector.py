@@ -107,8 +107,9 @@ class OnnxDetector:
     """A YOLO-family ONNX model with an input-size policy (see :func:`load_detector`)."""
 
     def __init__(self, session: ort.InferenceSession, *, path: Path, name: str, family: str, sha256: str, input_size: str | int,
-                 class_map: tuple[int, ...] | None = None):
+                 class_map: tuple[int, ...] | None = None, threads: int | None = None):
         self.session = session
+        self.threads = threads  # the session's intra-op threads (None: onnxruntime's default)
         self.class_map = class_map  # COCO-80 index per model class (-1: dropped); None: an 80-class COCO model
         self._class_lut = None if class_map is None else np.asarray(class_map, dtype=np.int64)
         self.path = Path(path)
@@ -121,6 +122,14 @@ class OnnxDetector:
         self._static_hw = _static_hw(session)
         self._dynamic_batch = not isinstance(session.get_inputs()[0].shape[0], int)
         self.passes: list[Pass] = plan_passes(self.input_size, self._static_hw, name)
+
+    def __reduce__(self):
+        """Pickled as what builds it, never as a session: another process (a sweep's worker)
+        opens the same model file again, its sha256 checked (:func:`benchmark.detectors.loader.reopen_detector`)."""
+        from benchmark.detectors.loader import reopen_detector
+
+        return reopen_detector, (self.path.absolute(), self.name, self.family, self.sha256, self.input_size,
+                                 self.class_map, self.threads)
 
     def __repr__(self) -> str:
         return f"OnnxDetector(name={self.name!r}, family={self.family!r}, input_size={self.input_size!r}, passes={[p.label for p in self.passes]})"

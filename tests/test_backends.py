@@ -1,0 +1,192 @@
+"""Backends and the render variant (issue 11, points 3-4): `generate` and `benchmark sweep`
+write the same bytes in this process, on a process pool and on a dask LocalCluster;
+``render.variant: auto`` is resolved, recorded and kept on resume; a ``--scheduler`` that
+cannot be used is one line before anything is written."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from conftest import SMOKE_MANIFEST, model_dir, require_model
+from metricscenes import backends
+from metricscenes.backends import BackendError, check_scheduler, map_units
+from test_sweep_cli import fakes  # noqa: F401 (a fixture)
+
+# Two environments (the bootstrap's minimum) at two distances, a 96 x 54 grid, daylight only:
+# 6 units of about half a second, so that three renders and two sweeps stay short.
+TINY = {**yaml.safe_load(SMOKE_MANIFEST.read_text()), "name": "tiny", "environments": 2, "distances_m": [50, 150],
+        "reference_grid": {"width_px": 96, "height_px": 54},
+        "render": {"plate_spp": 4, "inset_spp": 4, "inset_pixel_mrad": 0.5, "inset_max_px": 64, "max_depth": 3,
+                   "variant": "auto"},
+        "light_groups": ["sky_day"], "conditions": {"day": {"sky_day": 1.0}}}
+del TINY["illuminance_sweep"]
+
+
+def _cuda_usable() -> bool:
+    from metricscenes.render import resolve_variant
+
+    return resolve_variant("auto") != "scalar_spectral"
+
+
+@pytest.fixture(scope="module")
+def tiny_manifest_file(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("tiny") / "tiny.yaml"
+    path.write_text(yaml.safe_dump(TINY, sort_keys=False))
+    return path
+
+
+@pytest.fixture(scope="module")
+def serial_collection(tiny_manifest_file, tmp_path_factory) -> Path:
+    """The tiny collection rendered in this process (``--workers 1``)."""
+    from metricscenes.generate import generate
+    from metricscenes.manifest import load_manifest
+
+    return generate(load_manifest(tiny_manifest_file), tmp_path_factory.mktemp("serial") / "c", workers=1)
+
+
+# --- generate ------------------------------------------------------------------------------
+@pytest.mark.slow
+@pytest.mark.parametrize("options", [["--workers", "2"], ["--scheduler", "local", "--workers", "2"]],
+                         ids=["process-pool", "dask-local"])
+def test_generate_bytes_do_not_depend_on_the_backend(serial_collection, tiny_manifest_file, tmp_path, options):
+    from metricscenes.cli import app
+
+    out = tmp_path / "c"
+    result = CliRunner().invoke(app, ["generate", "--manifest", str(tiny_manifest_file), "--out", str(out), *options])
+    assert result.exit_code == 0, result.output
+    for name in ("manifest.resolved.yaml", "groundtruth.json"):  # every array's sha256, the boxes, the variant
+        assert (out / name).read_bytes() == (serial_collection / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_auto_variant_is_resolved_recorded_and_kept_on_resume(serial_collection, tmp_path):
+    from metricscenes.generate import generate
+    from metricscenes.manifest import parse_manifest
+    from metricscenes.store import CollectionError
+
+    resolved = yaml.safe_load((serial_collection / "manifest.resolved.yaml").read_text())
+    assert resolved["manifest"]["render"]["variant"] == "auto"
+    if not _cuda_usable():
+        assert resolved["render_variant"] == "scalar_spectral"
+    assert (serial_collection / "progress" / "render_variant").read_text().strip() == resolved["render_variant"]
+    # The same manifest resumed where `auto` means another variant: refused, nothing touched.
+    copy = shutil.copytree(serial_collection, tmp_path / "c")
+    (copy / "progress" / "render_variant").write_text("llvm_ad_spectral\n")
+    before = {p: p.read_bytes() for p in sorted(copy.rglob("*")) if p.is_file()}
+    with pytest.raises(CollectionError, match="rendered with Mitsuba variant llvm_ad_spectral") as refused:
+        generate(parse_manifest(TINY), copy)
+    assert "\n" not in str(refused.value)
+    assert {p: p.read_bytes() for p in sorted(copy.rglob("*")) if p.is_file()} == before
+
+
+def test_auto_variant_is_a_value_not_the_default():
+    """(The default stays scalar_spectral: it is part of every manifest's sha256, which
+    protocols.yaml pins; tests/test_leaderboard_submit.py checks those hashes.)"""
+    from metricscenes.manifest import parse_manifest
+    from metricscenes.render import resolve_variant
+
+    assert parse_manifest(TINY).render.variant == "auto"
+    default = {**TINY, "render": {k: v for k, v in TINY["render"].items() if k != "variant"}}
+    assert parse_manifest(default).render.variant == "scalar_spectral"
+    assert resolve_variant("auto") == ("cuda_ad_spectral" if _cuda_usable() else "scalar_spectral")
+
+
+# --- benchmark sweep -----------------------------------------------------------------------
+def _sweep_files(folder: Path) -> dict[str, bytes]:
+    """Every file of a sweep folder, results.json without its wall-clock ``timing_s``."""
+    files = {}
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        data = path.read_bytes()
+        if path.name == "results.json":
+            results = json.loads(data)
+            results.pop("timing_s")
+            data = json.dumps(results).encode()
+        files[str(path.relative_to(folder))] = data
+    return files
+
+
+@pytest.mark.slow
+def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.cameras import load_camera
+    from benchmark.detectors import load_detector
+    from benchmark.sweep import sweep
+
+    cameras = []
+    for name, f_number, pixel_um in (("small-a", 2.0, 11.2), ("small-b", 4.0, 8.4)):  # 240 x 135 and 320 x 180 px
+        spec = tmp_path / f"{name}.yaml"
+        spec.write_text(f"name: {name}\noptics: {{f_number: {f_number}}}\nsensor: {{pixel_um: {pixel_um}}}\n")
+        cameras.append(load_camera(spec))
+    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
+    options = dict(n_resamples=20, mtf_source="analytic")
+    serial = sweep(serial_collection, cameras, ["day"], detector, tmp_path / "serial", **options)
+    pooled = sweep(serial_collection, cameras, ["day"], detector, tmp_path / "pooled", workers=2, **options)
+    assert serial.equals(pooled)
+    files = _sweep_files(tmp_path / "serial")
+    assert any(name.endswith(".png") for name in files) and "runs/small-b-day/od50.json" in files
+    assert _sweep_files(tmp_path / "pooled") == files
+
+
+# --- the backends themselves ---------------------------------------------------------------
+def test_map_units_gives_every_result_whatever_the_backend():
+    units = [(2, n) for n in range(5)]
+    assert list(map_units(pow, units)) == [1, 2, 4, 8, 16]  # in this process: in order
+    assert sorted(map_units(pow, units, workers=2)) == [1, 2, 4, 8, 16]  # as they finish
+    with pytest.raises(ValueError, match="invalid literal"):  # a unit's error, raised in the client
+        list(map_units(int, [("12",), ("twelve",)], workers=2))
+
+
+@pytest.mark.parametrize("address", ["tcp://example.org", "http://example.org:8786", "tcp://host:99999", "tcp://:8786",
+                                     "locale", ""])
+def test_a_malformed_scheduler_is_one_line(address):
+    with pytest.raises(BackendError, match="expected 'local' or a dask scheduler address") as refused:
+        check_scheduler(address)
+    assert "\n" not in str(refused.value)
+
+
+def test_missing_dask_is_one_line(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(BackendError, match=r"pip install 'metricscenes\[dask\]'"):
+        check_scheduler("local")
+
+
+def _closed_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_unreachable_scheduler_is_one_line_before_any_output(tmp_path, monkeypatch):
+    from metricscenes.cli import app
+
+    monkeypatch.setattr(backends, "CONNECT_TIMEOUT_S", 0.5)
+    address = f"tcp://127.0.0.1:{_closed_port()}"
+    out = tmp_path / "c"
+    result = CliRunner().invoke(app, ["generate", "--manifest", str(SMOKE_MANIFEST), "--out", str(out),
+                                      "--scheduler", address])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: ") and f"{address}: no dask scheduler answers" in lines[0]
+    assert not out.exists()
+
+
+def test_sweep_refuses_an_unusable_scheduler_in_one_line(fakes, monkeypatch):  # noqa: F811
+    from benchmark.cli import app
+
+    monkeypatch.setattr(backends, "CONNECT_TIMEOUT_S", 0.5)
+    for address, message in ((f"tcp://127.0.0.1:{_closed_port()}", "no dask scheduler answers"),
+                             ("tcp://nowhere", "expected 'local'")):
+        result = CliRunner().invoke(app, ["sweep", "--collection", str(fakes), "--cameras", "cam01",
+                                          "--out", str(fakes / "sw"), "--scheduler", address])
+        assert result.exit_code == 2 and "Traceback" not in result.output
+        assert len([line for line in result.output.splitlines() if line.strip()]) == 1 and message in result.output
+        assert not (fakes / "sw").exists()
