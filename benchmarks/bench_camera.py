@@ -27,9 +27,9 @@ import numpy as np
 import scipy.fft as sfft
 import scipy.ndimage
 
-from benchmark import calibration, exposure, isp, optics, sensor
-from benchmark.camera import simulate
-from benchmark.cameras import load_camera
+from benchmark.camera import calibration, exposure, isp, optics, sensor
+from benchmark.camera.pipeline import simulate
+from benchmark.camera import load_camera
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
 from metricscenes.radiance import RadianceLayer, SpectralScene, _overlap_matrix, _weights
 from metricscenes.spectral import WAVELENGTHS_NM

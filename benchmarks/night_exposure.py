@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmark.camera import simulate
-from benchmark.cameras import load_camera
-from benchmark.exposure import central_region, parse_exposure, with_exposure
+from benchmark.camera.pipeline import simulate
+from benchmark.camera import load_camera
+from benchmark.camera.exposure import central_region, parse_exposure, with_exposure
 from metricscenes.groundtruth import scale_groundtruth
 from metricscenes.store import Collection
 

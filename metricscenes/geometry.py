@@ -7,7 +7,7 @@ differ only in sampling and f-number). Positions on the image plane are expresse
 angle below it): a perspective image is uniformly sampled in them, so a pixel grid of
 any camera maps onto them by a scale and an offset. A camera with another focal length
 or active area samples its own window of the collection's field, centred on the
-optical axis (:func:`centred_extent`, ``benchmark.camera.camera_window``).
+optical axis (:func:`centred_extent`, ``benchmark.camera.pipeline.camera_window``).
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
 """Shared by the leaderboard tests: a leaderboard's accepted-protocol file and the CLI app.
 
 PROTOCOLS accepts the smoke manifest with the 4 environments of the synthetic runs
-(:func:`benchmark.leaderboard.synthetic.write_synthetic_run`), not the collection's 2."""
+(:func:`synthetic_leaderboard.write_synthetic_run`), not the collection's 2."""
 
 from __future__ import annotations
 
 import typer
 
-from benchmark.cli_leaderboard import register
+from benchmark.cli.leaderboard import register
 
 PROTOCOLS = """protocols:
   smoke:

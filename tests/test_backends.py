@@ -115,9 +115,9 @@ def _sweep_files(folder: Path) -> dict[str, bytes]:
 @pytest.mark.slow
 def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
     require_model("yolov5n-dynamic.onnx")
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
-    from benchmark.sweep import sweep
+    from benchmark.experiments.sweep import sweep
 
     cameras = []
     for name, f_number, pixel_um in (("small-a", 2.0, 11.2), ("small-b", 4.0, 8.4)):  # 240 x 135 and 320 x 180 px
@@ -180,7 +180,7 @@ def test_unreachable_scheduler_is_one_line_before_any_output(tmp_path, monkeypat
 
 
 def test_sweep_refuses_an_unusable_scheduler_in_one_line(fakes, monkeypatch):  # noqa: F811
-    from benchmark.cli import app
+    from benchmark.cli.main import app
 
     monkeypatch.setattr(backends, "CONNECT_TIMEOUT_S", 0.5)
     for address, message in ((f"tcp://127.0.0.1:{_closed_port()}", "no dask scheduler answers"),

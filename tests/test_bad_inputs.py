@@ -310,7 +310,7 @@ def test_lock_is_released_when_generate_fails(tmp_path, smoke_manifest):
 def test_run_out_naming_a_file_is_one_line(tmp_path):
     out = tmp_path / "results.txt"
     out.write_text("precious\n")
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", tmp_path, "--out", out))
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", tmp_path, "--out", out))
     assert "is a file" in line and out.read_text() == "precious\n"
 
 
@@ -352,7 +352,7 @@ def test_run_on_a_truncated_chunk_leaves_no_partial_images(smoke_collection, tmp
     root = _copy(smoke_collection, tmp_path)
     _truncate_a_late_chunk(root)
     fresh = tmp_path / "runs" / "fresh"
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", root, "--out", fresh))
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", root, "--out", fresh))
     assert "scene env001-d150m" in line and "insets/env001-d150m/sky_day" in line
     assert not (tmp_path / "runs").exists()
     kept = tmp_path / "kept"
@@ -360,14 +360,14 @@ def test_run_on_a_truncated_chunk_leaves_no_partial_images(smoke_collection, tmp
     (kept / "results.json").write_text("{}")
     (kept / "images" / "env000-d025m.png").write_bytes(b"old")
     before = _snapshot(kept)
-    _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", root, "--out", kept))
+    _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", root, "--out", kept))
     assert _snapshot(kept) == before
 
 
 @pytest.mark.slow
 def test_run_with_a_nan_model_fails_halfway_without_output(smoke_collection, tmp_path):
     out = tmp_path / "out"
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", smoke_collection,
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", smoke_collection,
                                 "--model", _nan_yolov8(tmp_path, dynamic=False), "--input-size", "64", "--out", out))
     assert "not finite" in line and "nan.onnx" in line
     assert not out.exists()
@@ -386,7 +386,7 @@ def test_damaged_collection_files_are_one_line(smoke_collection, tmp_path, damag
         (root / "radiance.zarr" / "zarr.json").unlink()
     before = _snapshot(root)
     out = tmp_path / "out"
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", root, "--out", out))
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", root, "--out", out))
     assert words in line and not out.exists()
     line = _one_line_error(_run("metricscenes.cli", "info", root))
     assert words in line

@@ -10,11 +10,11 @@ import pytest
 from pydantic import ValidationError
 from typer.testing import CliRunner
 
-from benchmark import calibration, hdr, isp, sensor
-from benchmark.camera import electron_rate, simulate
-from benchmark.cameras import ExposureSpec, SensorSpec, list_cameras, load_camera
-from benchmark.cli import app
-from benchmark.exposure import (
+from benchmark.camera import calibration, hdr, isp, sensor
+from benchmark.camera.pipeline import electron_rate, simulate
+from benchmark.camera import ExposureSpec, SensorSpec, list_cameras, load_camera
+from benchmark.cli.main import app
+from benchmark.camera.exposure import (
     exposure_tag,
     exposure_time_s,
     format_exposure,
@@ -130,7 +130,7 @@ def test_default_specs_keep_their_canonical_json():
 
 @pytest.mark.parametrize("text, key, value", [("percentile:95", "percentile", 95.0), ("hdr:16", "hdr_ratio", 16.0)])
 def test_policy_parameters_are_recorded(text, key, value):
-    from benchmark.cameras import camera_from_dict
+    from benchmark.camera import camera_from_dict
 
     cam = with_exposure(load_camera("cam12"), parse_exposure(text))
     dump = cam.model_dump(mode="json")
@@ -321,7 +321,7 @@ def test_cli_run_overrides_the_camera_exposure(fakes, monkeypatch):  # noqa: F81
 
         return fake_run_camera(collection, camera, condition, detector, out_dir, **kw)
 
-    monkeypatch.setattr("benchmark.run.run_camera", run_camera)
+    monkeypatch.setattr("benchmark.experiments.run.run_camera", run_camera)
     result = CliRunner().invoke(app, ["run", "--camera", "cam05", "--collection", str(fakes), "--out",
                                       str(fakes / "r"), "--exposure", "percentile:95@0.5"])
     assert result.exit_code == 0, result.output
@@ -342,7 +342,7 @@ def test_sweep_policies_do_not_collide(fakes):  # noqa: F811
     assert plain == load_camera("cam01").sha256() != tagged
     meta = json.loads((out / "sweep.json").read_text())
     assert meta["exposure"]["policy"] == "hdr:16" and meta["runs"][0]["path"] == "runs/cam01-day+hdr-16"
-    from benchmark.report import load_results
+    from benchmark.experiments.report import load_results
 
     assert load_results(out)[2][("cam01", "day")] == runs / "cam01-day+hdr-16"
     # The reference policy, spelt out, is the cameras' own: the untagged runs are reused.
@@ -352,7 +352,7 @@ def test_sweep_policies_do_not_collide(fakes):  # noqa: F811
 
 
 def test_run_records_the_hdr_short_exposures(tmp_path):
-    from benchmark.run import run_camera
+    from benchmark.experiments.run import run_camera
     from test_sweep_cache import FakeCollection
 
     class Collection(FakeCollection):

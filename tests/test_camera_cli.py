@@ -7,7 +7,7 @@ import pytest
 
 from typer.testing import CliRunner
 
-from benchmark.cli_cameras import app
+from benchmark.cli.cameras import app
 
 runner = CliRunner()
 

@@ -5,9 +5,9 @@ folds is refused, and a zero distortion changes nothing (specs, hashes, images).
 import numpy as np
 import pytest
 
-from benchmark.camera import FieldOfViewError, camera_window, electron_rate, lens_mapping
-from benchmark.cameras import camera_from_dict
-from benchmark.distortion import distort, undistort
+from benchmark.camera.pipeline import FieldOfViewError, camera_window, electron_rate, lens_mapping
+from benchmark.camera import camera_from_dict
+from benchmark.camera.distortion import distort, undistort
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, tan_to_grid
 from metricscenes.groundtruth import scale_groundtruth
 from metricscenes.radiance import RadianceLayer, SpectralScene

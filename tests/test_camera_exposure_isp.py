@@ -4,10 +4,10 @@ import colour
 import numpy as np
 import pytest
 
-from benchmark import calibration, exposure
-from benchmark.camera import simulate
-from benchmark.cameras import CameraSpec, load_camera
-from benchmark.sensor import signal_volts_per_electron
+from benchmark.camera import calibration, exposure
+from benchmark.camera.pipeline import simulate
+from benchmark.camera import CameraSpec, load_camera
+from benchmark.camera.sensor import signal_volts_per_electron
 from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
 

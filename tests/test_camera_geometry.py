@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from benchmark import optics as _optics
-from benchmark import sensor as _sensor
-from benchmark.camera import FieldOfViewError, camera_extent, camera_window, electron_rate
-from benchmark.cameras import camera_from_dict, list_cameras, load_camera
-from benchmark.run import camera_geometry, collection_field, run_camera
+from benchmark.camera import optics as _optics
+from benchmark.camera import sensor as _sensor
+from benchmark.camera.pipeline import FieldOfViewError, camera_extent, camera_window, electron_rate
+from benchmark.camera import camera_from_dict, list_cameras, load_camera
+from benchmark.experiments.run import camera_geometry, collection_field, run_camera
 from metricscenes.geometry import (
     HORIZONTAL_FOV_DEG,
     REFERENCE_EXTENT,

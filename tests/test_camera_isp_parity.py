@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from benchmark import calibration, isp
-from benchmark import sensor as sensor_module
-from benchmark.cameras import list_cameras, load_camera
-from benchmark.cameras.spec import CameraSpec, ISPSpec, isp_preset
-from benchmark.cli_cameras import app
-from benchmark.mtf import (
+from benchmark.camera import calibration, isp
+from benchmark.camera import sensor as sensor_module
+from benchmark.camera import list_cameras, load_camera
+from benchmark.camera.spec import CameraSpec, ISPSpec, isp_preset
+from benchmark.cli.cameras import app
+from benchmark.measure.mtf import (
     LUMINANCE_WEIGHTS,
     esf_mtf,
     esf_mtf_isetcam,
@@ -23,9 +23,9 @@ from benchmark.mtf import (
     mtf50_analytic_cy_per_mm,
     mtf50_isetcam,
 )
-from benchmark.optics import diffraction_mtf
-from benchmark.sensor import mosaic
-from benchmark.targets import synthetic_edge_image
+from benchmark.camera.optics import diffraction_mtf
+from benchmark.camera.sensor import mosaic
+from benchmark.measure.targets import synthetic_edge_image
 
 runner = CliRunner()
 PARITY = isp_preset("iset-parity")

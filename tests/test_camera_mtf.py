@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from benchmark.cameras import load_camera
-from benchmark.mtf import esf_mtf, measure_mtf50, mtf50, mtf50_analytic_cy_per_mm
-from benchmark.optics import diffraction_mtf
-from benchmark.targets import square_coverage, synthetic_edge_image
+from benchmark.camera import load_camera
+from benchmark.measure.mtf import esf_mtf, measure_mtf50, mtf50, mtf50_analytic_cy_per_mm
+from benchmark.camera.optics import diffraction_mtf
+from benchmark.measure.targets import square_coverage, synthetic_edge_image
 
 
 @pytest.mark.parametrize("pixel_um", [1.4, 2.8])

@@ -6,14 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark import optics, sensor
-from benchmark.camera import electron_rate, simulate
-from benchmark.cameras import camera_from_dict, load_camera
+from benchmark.camera import optics, sensor
+from benchmark.camera.pipeline import electron_rate, simulate
+from benchmark.camera import camera_from_dict, load_camera
 from metricscenes.radiance import SpectralScene
 from metricscenes.spectral import WAVELENGTHS_NM
 
 H_J_S, C_M_S = 6.62607015e-34, 299792458.0
-QE_CSV = Path(__file__).resolve().parents[1] / "benchmark" / "cameras" / "data" / "imx363_qe.csv"
+QE_CSV = Path(__file__).resolve().parents[1] / "benchmark" / "camera" / "data" / "imx363_qe.csv"
 
 
 def _hand_electrons(radiance, f_number, pixel_um, exposure_s, transmittance=1.0):

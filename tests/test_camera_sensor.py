@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from benchmark import sensor as S
-from benchmark.camera import simulate
-from benchmark.cameras import load_camera
+from benchmark.camera import sensor as S
+from benchmark.camera.pipeline import simulate
+from benchmark.camera import load_camera
 from metricscenes.radiance import SpectralScene
 
 SPEC = load_camera("cam10").sensor

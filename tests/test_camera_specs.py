@@ -2,7 +2,7 @@
 
 import pytest
 
-from benchmark.cameras import CameraSpec, camera_names, list_cameras, load_camera
+from benchmark.camera import CameraSpec, camera_names, list_cameras, load_camera
 
 PAPER = [(4.2, 3.1, 55), (3.5, 6.4, 55), (2.8, 9.1, 55), (2.1, 10.9, 55), (2.8, 3.8, 75), (2.1, 6.4, 75),
          (1.4, 3.3, 75), (1.0, 8.9, 75), (2.1, 2.7, 100), (1.4, 5.4, 100), (1.0, 6.1, 100), (1.4, 1.9, 150),
@@ -107,9 +107,9 @@ def test_unknown_illuminant_is_refused_and_known_ones_pass(tmp_path):
 def test_qe_user_file_is_read_beside_the_spec_file(tmp_path, monkeypatch):
     import numpy as np
 
-    from benchmark.cameras import DATA_DIR
-    from benchmark.calibration import color_matrix
-    from benchmark.sensor import effective_qe
+    from benchmark.camera import DATA_DIR
+    from benchmark.camera.calibration import color_matrix
+    from benchmark.camera.sensor import effective_qe
 
     folder = tmp_path / "mycam"
     (folder / "data").mkdir(parents=True)

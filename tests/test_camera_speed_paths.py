@@ -7,9 +7,9 @@ import colour_demosaicing
 import numpy as np
 import pytest
 
-from benchmark import optics, sensor
-from benchmark.cameras import load_camera
-from benchmark.demosaic import malvar2004
+from benchmark.camera import optics, sensor
+from benchmark.camera import load_camera
+from benchmark.camera.demosaic import malvar2004
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
 from metricscenes.radiance import RadianceLayer, SpectralScene, _axis_matrix
 from metricscenes.spectral import WAVELENGTHS_NM
@@ -96,8 +96,8 @@ def test_fast_channel_signal_on_band_planar_input_equals_per_band_irradiance(nam
 def test_electron_rate_is_the_optical_image_through_the_sensor(distortion):
     """The camera's fused path equals the plain one through the values between stages:
     scene → optical image (irradiance on the pixel grid) → sensor signal."""
-    from benchmark.camera import electron_rate, optical_image
-    from benchmark.cameras import camera_from_dict
+    from benchmark.camera.pipeline import electron_rate, optical_image
+    from benchmark.camera import camera_from_dict
     from metricscenes.radiance import RadianceLayer, SpectralScene
 
     optics_spec = {"f_number": 2.2, "focal_length_mm": 5.0}

@@ -40,13 +40,13 @@ def test_dry_run_prints_the_plan():
 
 @pytest.mark.slow
 def test_missing_model_file_is_one_line(smoke_collection, tmp_path):
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam12", "--collection", smoke_collection,
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam12", "--collection", smoke_collection,
                                 "--model", tmp_path / "nope.onnx", "--out", tmp_path / "r"))
     assert "nope.onnx" in line
 
 
 def test_unknown_camera_and_collection_are_one_line(tmp_path):
-    line = _one_line_error(_run("benchmark.cli", "run", "--camera", "cam99", "--collection", tmp_path,
+    line = _one_line_error(_run("benchmark.cli.main", "run", "--camera", "cam99", "--collection", tmp_path,
                                 "--out", tmp_path / "r"))
     assert "cam99" in line
     line = _one_line_error(_run("metricscenes.cli", "info", tmp_path / "absent"))
@@ -56,8 +56,8 @@ def test_unknown_camera_and_collection_are_one_line(tmp_path):
 def test_score_rescores_a_run_folder(tmp_path):
     from typer.testing import CliRunner
 
-    from benchmark.cli import app
-    from benchmark.scoring.synthetic import synthetic_collection
+    from benchmark.cli.main import app
+    from synthetic_scoring import synthetic_collection
 
     gt, dets = synthetic_collection(n_environments=4, seed=3)
     (tmp_path / "groundtruth.json").write_text(json.dumps(gt))
@@ -67,7 +67,7 @@ def test_score_rescores_a_run_folder(tmp_path):
     ref = json.loads(runner.invoke(app, ["score", str(tmp_path), "--json", "--backend", "pycocotools"]).output)
     assert [r["ap"] for r in fast["per_distance"]] == pytest.approx([r["ap"] for r in ref["per_distance"]], abs=1e-12)
     assert all(0 <= r["rate"] <= 1 for r in fast["per_distance"])
-    line = _one_line_error(_run("benchmark.cli", "score", tmp_path / "absent"))
+    line = _one_line_error(_run("benchmark.cli.main", "score", tmp_path / "absent"))
     assert "not a run folder" in line
 
 

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmark.camera import FieldOfViewError, camera_window
-from benchmark.cameras import camera_from_dict
-from benchmark.run import collection_field
+from benchmark.camera.pipeline import FieldOfViewError, camera_window
+from benchmark.camera import camera_from_dict
+from benchmark.experiments.run import collection_field
 from metricscenes.geometry import REFERENCE_EXTENT, field_extent, fov_deg
 from metricscenes.groundtruth import box_tan_to_xywh, car_box_tan
 from metricscenes.manifest import ManifestError, canonical_sha256, load_manifest, parse_manifest

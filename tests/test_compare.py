@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from benchmark.compare import CompareError, Side, compare_runs, load_side, verdict
-from benchmark.scoring.synthetic import synthetic_collection
+from benchmark.experiments.compare import CompareError, Side, compare_runs, load_side, verdict
+from synthetic_scoring import synthetic_collection
 
 SHA = "f" * 64
 
@@ -93,7 +93,7 @@ def test_censored_od50_is_not_a_difference():
 
 
 def test_cli_runs_and_refuses_in_one_line(tmp_path, run20):
-    from benchmark.cli import app
+    from benchmark.cli.main import app
 
     gt, dets = run20
     for name, d, sha in (("a", dets, SHA), ("b", degraded(gt, dets), SHA), ("c", dets, "0" * 64)):

@@ -23,7 +23,7 @@ def _default(command, name):
 
 
 def test_detect_run_and_sweep_share_one_default_input_size():
-    from benchmark import cli, cli_detect
+    from benchmark.cli import main as cli, detect as cli_detect
 
     assert DEFAULT_INPUT_SIZE == "multiscale"  # the reference policy
     assert _default(cli_detect.detect, "input_size") == _default(cli.run, "input_size") \
@@ -53,8 +53,8 @@ class FakeDetector:
 
 @pytest.fixture
 def app(monkeypatch):
-    from benchmark import cli_detect
-    from benchmark.cli import app
+    from benchmark.cli import detect as cli_detect
+    from benchmark.cli.main import app
 
     seen = {}
 

@@ -59,8 +59,8 @@ def test_custom_classes_dropped_and_merged(tmp_path):
 
 
 def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
-    from benchmark.cameras import load_camera
-    from benchmark.sweep import results_key, run_key
+    from benchmark.camera import load_camera
+    from benchmark.experiments.sweep import results_key, run_key
     from test_sweep_cache import FakeCollection, FakeDetector
 
     class Mapped(FakeDetector):
@@ -78,7 +78,7 @@ def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
 def test_cli_class_map_errors_are_one_line(tmp_path):
     from typer.testing import CliRunner
 
-    from benchmark.cli import app
+    from benchmark.cli.main import app
 
     model = _yolov5_model(tmp_path, 1, [(32, 32, 20, 10, 0.9, 0, 1.0)])
     image = tmp_path / "x.png"
@@ -95,9 +95,9 @@ def test_cli_class_map_errors_are_one_line(tmp_path):
 
 
 def test_run_camera_writes_the_class_map(tmp_path, monkeypatch):
-    import benchmark.camera
-    from benchmark.cameras import load_camera
-    from benchmark.run import run_camera
+    import benchmark.camera.pipeline
+    from benchmark.camera import load_camera
+    from benchmark.experiments.run import run_camera
     from test_sweep_cache import FakeCollection
 
     class Capture:
@@ -117,6 +117,6 @@ def test_run_camera_writes_the_class_map(tmp_path, monkeypatch):
         def radiance(self, scene_id, condition):
             return None
 
-    monkeypatch.setattr(benchmark.camera, "simulate", lambda radiance, camera, seed: Capture())
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
     results = run_camera(Collection(tmp_path), load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
     assert results["detector"]["class_map"] == ["car"]

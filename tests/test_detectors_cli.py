@@ -8,7 +8,7 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from benchmark.cli_detect import register
+from benchmark.cli.detect import register
 
 REPO = Path(__file__).resolve().parents[1]
 MODEL_DIR = Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))

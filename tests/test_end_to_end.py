@@ -12,7 +12,7 @@ pytestmark = pytest.mark.slow
 def test_benchmark_run_scores_every_distance(smoke_collection, tmp_path):
     from typer.testing import CliRunner
 
-    from benchmark.cli import app
+    from benchmark.cli.main import app
 
     require_model("yolov5n-dynamic.onnx")
     out = tmp_path / "results"

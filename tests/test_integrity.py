@@ -177,7 +177,7 @@ def test_collections_without_mask_and_groundtruth_hashes_are_still_read_and_chec
 # --- benchmark never writes into a collection; names that become paths ------------------
 
 def test_out_inside_a_collection_is_refused(smoke_collection, tmp_path):
-    from benchmark.run import check_out_dir, run_camera
+    from benchmark.experiments.run import check_out_dir, run_camera
 
     for out in (smoke_collection, smoke_collection / "results", smoke_collection / "radiance.zarr" / "x"):
         with pytest.raises(ValueError, match="read-only"):
@@ -191,7 +191,7 @@ def test_out_inside_a_collection_is_refused(smoke_collection, tmp_path):
 @pytest.mark.parametrize("command", ["run", "sweep"])
 def test_cli_out_inside_a_collection_is_one_line(smoke_collection, command):
     extra = ["--camera", "cam12"] if command == "run" else ["--cameras", "cam12", "--conditions", "day"]
-    proc = subprocess.run([sys.executable, "-m", "benchmark.cli", command, "--collection", str(smoke_collection),
+    proc = subprocess.run([sys.executable, "-m", "benchmark.cli.main", command, "--collection", str(smoke_collection),
                            "--out", str(smoke_collection / "results"), *extra],
                           capture_output=True, text=True, cwd=REPO, timeout=300)
     assert proc.returncode != 0 and "Traceback" not in proc.stdout + proc.stderr
@@ -202,8 +202,8 @@ def test_cli_out_inside_a_collection_is_one_line(smoke_collection, command):
 
 @pytest.mark.parametrize("name", ["", "..", "a..b", "a/b", "a\\b", "a\0b", "a\nb", "a\rb"])
 def test_path_name_rule_rejects(name):
-    from benchmark.run import check_path_name
-    from benchmark.sweep import run_name
+    from benchmark.experiments.run import check_path_name
+    from benchmark.experiments.sweep import run_name
 
     with pytest.raises(ValueError, match="cannot name a folder"):
         check_path_name(name, "name")
@@ -215,13 +215,13 @@ def test_path_name_rule_rejects(name):
 
 @pytest.mark.parametrize("name", ["day", "day@0.25lux", "cam01", "hdr-16", "percentile-99.9-level0.18"])
 def test_path_name_rule_accepts(name):
-    from benchmark.run import check_path_name
+    from benchmark.experiments.run import check_path_name
 
     assert check_path_name(name, "name") == name
 
 
 def test_out_folder_name_follows_the_rule(tmp_path):
-    from benchmark.run import check_out_dir
+    from benchmark.experiments.run import check_out_dir
 
     for out in (tmp_path / "x" / "..", Path("."), Path("")):
         with pytest.raises(ValueError, match="cannot name a folder"):
@@ -230,8 +230,8 @@ def test_out_folder_name_follows_the_rule(tmp_path):
 
 def test_sweep_refuses_a_condition_that_is_not_a_folder_name(tmp_path):
     """A collection whose manifest names a condition '../escape': no run folder is made."""
-    from benchmark.cameras import load_camera
-    from benchmark.sweep import sweep
+    from benchmark.camera import load_camera
+    from benchmark.experiments.sweep import sweep
 
     class Collectionish:
         root, name, manifest_sha256 = tmp_path, "fake", "f" * 64

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from benchmark.leaderboard import build_submission, find_runs, load_protocols, render_leaderboard, write_submission
-from benchmark.leaderboard.synthetic import write_synthetic_run
+from synthetic_leaderboard import write_synthetic_run
 
 REPO = Path(__file__).resolve().parents[1]
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -48,7 +48,7 @@ def chromium_works(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def page(tmp_path_factory):
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
     from metricscenes.manifest import load_manifest
 
     root = tmp_path_factory.mktemp("html")

@@ -24,7 +24,7 @@ from benchmark.leaderboard import (
     schema_text,
     tree_sha256,
 )
-from benchmark.leaderboard.synthetic import write_synthetic_run
+from synthetic_leaderboard import write_synthetic_run
 
 from leaderboard_support import PROTOCOLS, leaderboard_app
 
@@ -55,7 +55,7 @@ def leaderboard(tmp_path, manifest):
 @pytest.fixture(scope="module")
 def sweep(tmp_path_factory, manifest):
     """A sweep folder: cam03 day+night, cam07 day (+ a day@100lux run the leaderboard does not rank)."""
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
 
     root = tmp_path_factory.mktemp("sweep")
     for cam, cond, half in (("cam03", "day", 120.0), ("cam03", "night", 60.0), ("cam07", "day", 80.0), ("cam07", "day@100lux", 70.0)):
@@ -113,8 +113,8 @@ def test_submit_a_run_folder(app, sweep, leaderboard, monkeypatch):
     assert day["od50_sd_m"] == pytest.approx(boot["sd_m"], abs=5e-4) and day["od50_sd_m"] > 0
     assert day["n_environments"] == 4
     assert sub["detector"]["licence"] == "AGPL-3.0" and sub["camera"]["mtf50_source"] == "measured"
-    from benchmark.cameras import load_camera
-    from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
+    from benchmark.camera import load_camera
+    from benchmark.measure.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
 
     spec_mtf = measure_mtf50(load_camera("cam03"))["mtf50_cy_per_mm"]
     assert sub["camera"]["mtf50_cy_per_mm"] == pytest.approx(spec_mtf, abs=0.06)
@@ -148,7 +148,7 @@ def test_submit_a_sweep(app, sweep, leaderboard):
 
 
 def test_sweep_bootstrap_cache_is_used(tmp_path, sweep, leaderboard):
-    """A sweep's per-run od50.json (benchmark.sweep.run_od50) with the same settings is reused, not recomputed."""
+    """A sweep's per-run od50.json (benchmark.experiments.sweep.run_od50) with the same settings is reused, not recomputed."""
     run = tmp_path / "run"
     shutil.copytree(sweep / "runs" / "cam07-day", run)
     sha = json.loads((run / "results.json").read_text())["detections_sha256"]
@@ -271,9 +271,9 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     model_dir = Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
     if not (model_dir / "yolov5n-dynamic.onnx").is_file():
         pytest.skip(f"yolov5n-dynamic.onnx not found in METRICSCENES_MODEL_DIR={model_dir}")
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
-    from benchmark.run import run_camera
+    from benchmark.experiments.run import run_camera
     from metricscenes.store import Collection
 
     collection = Collection.open(smoke_collection)

@@ -22,7 +22,7 @@ from benchmark.leaderboard import (
     tree_sha256,
     write_submission,
 )
-from benchmark.leaderboard.synthetic import write_synthetic_run
+from synthetic_leaderboard import write_synthetic_run
 from benchmark.scoring import od50
 
 from leaderboard_support import PROTOCOLS, leaderboard_app
@@ -39,7 +39,7 @@ def app():
 @pytest.fixture(scope="module")
 def world(tmp_path_factory):
     """A leaderboard holding one submission, and a valid second submission (with its run) outside it."""
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
     from metricscenes.manifest import load_manifest
 
     root = tmp_path_factory.mktemp("lb")

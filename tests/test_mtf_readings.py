@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from benchmark.mtf import mtf50, mtf_crossing, mtf_figure, mtf_readings
+from benchmark.measure.mtf import mtf50, mtf_crossing, mtf_figure, mtf_readings
 
 
 def _gauss_curve(pixel_um: float, sigma_cy_per_px: float = 0.3):
@@ -67,15 +67,15 @@ def test_figure_mixed_pitches_has_a_cycles_per_pixel_panel():
 
 
 def test_cameras_mtf_prints_and_returns_the_readings(tmp_path, monkeypatch):
-    import benchmark.mtf
-    from benchmark.cli_cameras import app
+    import benchmark.measure.mtf
+    from benchmark.cli.cameras import app
 
     def fake_measure(camera, esfr="iso"):
         freq, mtf = _gauss_curve(camera.pixel_um)
         return {"freq_cy_per_mm": freq, "mtf": mtf, "mtf50_cy_per_mm": mtf50(freq, mtf),
                 "mtf50_cy_per_px": mtf50(freq, mtf) * camera.pixel_um * 1e-3}
 
-    monkeypatch.setattr(benchmark.mtf, "measure_mtf50", fake_measure)
+    monkeypatch.setattr(benchmark.measure.mtf, "measure_mtf50", fake_measure)
     res = CliRunner().invoke(app, ["mtf", "cam13", "--json", "--plot", str(tmp_path / "mtf.png")])
     assert res.exit_code == 0, res.output
     (row,) = json.loads(res.stdout)

@@ -1,4 +1,4 @@
-"""benchmark.report: self-contained HTML from a sweep folder and from a single run folder."""
+"""benchmark.experiments.report: self-contained HTML from a sweep folder and from a single run folder."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 from PIL import Image
 
-from benchmark import report as report_module
+from benchmark.experiments import report as report_module
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from test_sweep_cache import make_fake_sweep  # the fake runs (tests/ is on sys.path)
 

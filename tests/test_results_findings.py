@@ -8,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from benchmark.acceptance import night_findings, paper_findings
+from benchmark.experiments.acceptance import night_findings, paper_findings
 
 DATA = Path(__file__).resolve().parents[1] / "docs" / "data"
 

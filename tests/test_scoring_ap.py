@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from benchmark.scoring import ap_by_distance
-from benchmark.scoring.synthetic import synthetic_collection
+from synthetic_scoring import synthetic_collection
 
 
 def _gt(boxes_by_distance):

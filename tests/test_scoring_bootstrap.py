@@ -5,7 +5,7 @@ import pytest
 
 from benchmark.scoring import ap_by_distance, bootstrap_od50, resample_environments
 from benchmark.scoring.bootstrap import _match_tables, weighted_ap
-from benchmark.scoring.synthetic import synthetic_collection
+from synthetic_scoring import synthetic_collection
 
 
 @pytest.mark.parametrize("seed", [0, 1])

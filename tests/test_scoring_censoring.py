@@ -49,7 +49,7 @@ def test_format_shows_the_bound_not_the_number():
 def test_one_bootstrap_default():
     import inspect
 
-    from benchmark import sweep
+    from benchmark.experiments import sweep
     from benchmark.leaderboard import submission
     from benchmark.scoring import bootstrap_od50
 
@@ -57,12 +57,12 @@ def test_one_bootstrap_default():
     assert inspect.signature(bootstrap_od50).parameters["n_resamples"].default == BOOTSTRAP_RESAMPLES
     assert inspect.signature(sweep.sweep).parameters["n_resamples"].default == BOOTSTRAP_RESAMPLES
     assert submission.N_RESAMPLES == BOOTSTRAP_RESAMPLES
-    assert "n_resamples=200" not in (REPO / "benchmark" / "report.py").read_text()
+    assert "n_resamples=200" not in (REPO / "benchmark" / "experiments" / "report.py").read_text()
 
 
 def test_bootstrap_reports_censoring():
     from benchmark.scoring import bootstrap_od50
-    from benchmark.scoring.synthetic import synthetic_collection
+    from synthetic_scoring import synthetic_collection
 
     gt, dets = synthetic_collection(6, seed=1, half_range_m=1000.0)  # AP stays high: beyond the far end
     out = bootstrap_od50(gt, dets, n_resamples=20)
@@ -70,8 +70,8 @@ def test_bootstrap_reports_censoring():
 
 
 def test_with_censoring_and_summary_table():
-    from benchmark.report import summary_table
-    from benchmark.sweep import od50_cell, with_censoring
+    from benchmark.experiments.report import summary_table
+    from benchmark.experiments.sweep import od50_cell, with_censoring
 
     rows = []
     for cam, ap in (("far", [0.9, 0.8, 0.8, 0.7, 0.6, 0.6]), ("mid", [0.9, 0.8, 0.6, 0.4, 0.2, 0.1]),
@@ -91,7 +91,7 @@ def test_with_censoring_and_summary_table():
 
 
 def test_figure_labels_bounds(tmp_path):
-    from benchmark import spm
+    from benchmark.experiments import spm
 
     od = pd.DataFrame({"condition": ["day"] * 4, "mtf50_cy_per_mm": [80.0, 100.0, 120.0, 200.0],
                        "od50_m": [90.0, 110.0, 130.0, 1626.0], "sd_m": [5.0] * 4,
@@ -103,7 +103,7 @@ def test_figure_labels_bounds(tmp_path):
 
 
 def test_sweep_od50_csv_has_censored_column(tmp_path, monkeypatch):
-    from benchmark import sweep as sweep_module
+    from benchmark.experiments import sweep as sweep_module
     from test_sweep_cache import make_fake_sweep
 
     make_fake_sweep(tmp_path / "sw", monkeypatch)
@@ -152,7 +152,7 @@ def test_committed_leaderboard_shows_no_extrapolated_number():
 
 
 def test_run_and_score_print_a_bound_not_an_extrapolation():
-    from benchmark.cli import od50_text
+    from benchmark.cli.main import od50_text
 
     rows = lambda aps: [{"distance_m": d, "ap": a} for d, a in zip((25.0, 50.0, 100.0, 200.0), aps)]  # noqa: E731
     assert od50_text(rows((0.9, 0.85, 0.8, 0.7))) == "OD50 > 200 m"  # extrapolation would say ~480 m

@@ -1,4 +1,4 @@
-"""benchmark.spm on synthetic tables: files written, the surface passes through the
+"""benchmark.experiments.spm on synthetic tables: files written, the surface passes through the
 measured points and is linear between them, OD50-vs-MTF50 slope."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark import spm
+from benchmark.experiments import spm
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 

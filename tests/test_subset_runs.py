@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from benchmark.cameras import load_camera
-from benchmark.cli import app
-from benchmark.run import CollectionSubset, parse_subset, run_camera, subset_collection
+from benchmark.camera import load_camera
+from benchmark.cli.main import app
+from benchmark.experiments.run import CollectionSubset, parse_subset, run_camera, subset_collection
 from test_sweep_cache import N_ENV, FakeCollection, FakeDetector, fake_run_camera
 
 
@@ -44,7 +44,7 @@ def test_parse_subset_ranges_and_errors(tmp_path):
 
 def test_run_camera_records_the_subset(tmp_path, monkeypatch):
     """The real run_camera on a subset: only the chosen scenes, ground truth to match, results.json marked."""
-    import benchmark.camera
+    import benchmark.camera.pipeline
 
     class Capture:
         rgb8 = np.zeros((8, 8, 3), np.uint8)
@@ -60,7 +60,7 @@ def test_run_camera_records_the_subset(tmp_path, monkeypatch):
         def radiance(self, scene_id, condition):
             return None
 
-    monkeypatch.setattr(benchmark.camera, "simulate", lambda radiance, camera, seed: Capture())
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
     col = Collection(tmp_path)
     view = subset_collection(col, "1", None)
     results = run_camera(view, load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
@@ -85,7 +85,7 @@ def fakes(monkeypatch, tmp_path):
             (args[3] / "results.json").write_text(json.dumps(results))
         return results
 
-    monkeypatch.setattr("benchmark.run.run_camera", run)
+    monkeypatch.setattr("benchmark.experiments.run.run_camera", run)
     monkeypatch.setattr(metricscenes.store.Collection, "open", classmethod(lambda cls, path: FakeCollection(tmp_path)))
     monkeypatch.setattr(benchmark.detectors, "load_detector", lambda model, **kw: FakeDetector(name=model))
     return tmp_path
@@ -113,7 +113,7 @@ def test_subset_sweep_is_marked_and_never_reused_as_full(fakes):
 
 
 def test_subset_cache_key(tmp_path):
-    from benchmark.sweep import results_key, run_key
+    from benchmark.experiments.sweep import results_key, run_key
 
     col = FakeCollection(tmp_path)
     cam = load_camera("cam01")

@@ -1,4 +1,4 @@
-"""benchmark.acceptance.paper_findings on synthetic tables: each finding met and violated."""
+"""benchmark.experiments.acceptance.paper_findings on synthetic tables: each finding met and violated."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark.acceptance import ap_distance_rho, night_findings, paper_findings
+from benchmark.experiments.acceptance import ap_distance_rho, night_findings, paper_findings
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 MTF50 = {"cam01": 60.0, "cam02": 80.0, "cam03": 110.0, "cam04": 150.0}

@@ -1,8 +1,8 @@
-"""benchmark.sweep: table shape, run cache, resume, OD50 table — with a fake run_camera.
+"""benchmark.experiments.sweep: table shape, run cache, resume, OD50 table — with a fake run_camera.
 
-The fake writes what :func:`benchmark.run.run_camera` writes (results.json last,
+The fake writes what :func:`benchmark.experiments.run.run_camera` writes (results.json last,
 detections, scaled ground truth, images) from the seeded synthetic detector of
-``benchmark.scoring.synthetic``, whose range grows as the pixel shrinks and halves at
+``synthetic_scoring``, whose range grows as the pixel shrinks and halves at
 night, so no rendering or detector is needed. ``tests/test_report_html.py`` reuses it.
 """
 
@@ -16,10 +16,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark import sweep as sweep_module
-from benchmark.cameras import load_camera
+from benchmark.experiments import sweep as sweep_module
+from benchmark.camera import load_camera
 from benchmark.scoring import ap_by_distance, bootstrap_od50
-from benchmark.scoring.synthetic import synthetic_collection
+from synthetic_scoring import synthetic_collection
 
 N_ENV = 4
 
@@ -79,7 +79,7 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
     """Writes the files of a real run; detections from the synthetic detector."""
     from PIL import Image, ImageDraw
 
-    from benchmark.run import sha256_bytes
+    from benchmark.experiments.run import sha256_bytes
     from metricscenes.groundtruth import scale_groundtruth
 
     out_dir = Path(out_dir)
@@ -134,7 +134,7 @@ CAMERAS = ("cam01", "cam12")
 
 def make_fake_sweep(out: Path, monkeypatch, *, run=None, cameras=CAMERAS, conditions=("day", "night"), **kw):
     """A sweep folder from the fake runs (public helper for the report tests)."""
-    monkeypatch.setattr("benchmark.run.run_camera", run or fake_run_camera)
+    monkeypatch.setattr("benchmark.experiments.run.run_camera", run or fake_run_camera)
     kw.setdefault("n_resamples", 50)
     kw.setdefault("mtf_source", "analytic")
     kw.setdefault("save_images", False)  # the report tests ask for them

@@ -13,8 +13,8 @@ from conftest import require_model
 @pytest.mark.slow
 def test_smoke_sweep_is_cached_and_reported(smoke_collection, tmp_path, monkeypatch):
     require_model("yolov5n-dynamic.onnx")
-    from benchmark import report, sweep
-    from benchmark.cameras import load_camera
+    from benchmark.experiments import report, sweep
+    from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
     from conftest import model_dir
 
@@ -28,7 +28,7 @@ def test_smoke_sweep_is_cached_and_reported(smoke_collection, tmp_path, monkeypa
     def no_run(*args, **kwargs):
         raise AssertionError("a cached run was recomputed")
 
-    monkeypatch.setattr("benchmark.run.run_camera", no_run)
+    monkeypatch.setattr("benchmark.experiments.run.run_camera", no_run)
     again = sweep.sweep(smoke_collection, [load_camera("cam01")], ["day", "night"], detector, out, n_resamples=20)
     pd.testing.assert_frame_equal(again, table)
 

@@ -102,10 +102,10 @@ def _detector_licence(detector: dict) -> str:
 
 
 def _mtf50(spec, measure: bool) -> tuple[float | None, str]:
-    """The camera's MTF50 by the one policy (:func:`benchmark.mtf.camera_mtf50`): from the
+    """The camera's MTF50 by the one policy (:func:`benchmark.measure.mtf.camera_mtf50`): from the
     slanted edge on when ``measure``, else from the published group on; a measured or
     analytic value rounded to 0.1 cy/mm."""
-    from benchmark.mtf import camera_mtf50
+    from benchmark.measure.mtf import camera_mtf50
 
     value, source = camera_mtf50(spec, "measured" if measure else "published_group")
     return (round(value, 1) if source in ("measured", "analytic") else value), source
@@ -117,7 +117,7 @@ def _float(value) -> float:
 
 
 def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> dict | None:
-    """The bootstrap a sweep stored in ``<run>/od50.json`` (:func:`benchmark.sweep.run_od50`), if it is for these settings."""
+    """The bootstrap a sweep stored in ``<run>/od50.json`` (:func:`benchmark.experiments.sweep.run_od50`), if it is for these settings."""
     try:
         stored = json.loads((folder / "od50.json").read_text(encoding="utf-8"))
         if stored["key"] != {"detections_sha256": detections_sha256, "n_resamples": n_resamples, "seed": seed}:

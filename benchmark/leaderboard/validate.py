@@ -95,7 +95,7 @@ def camera_from_dump(spec: dict, source: str = "camera.spec"):
     spec resolves to; fields the dump lacks take the current defaults (a spec written
     before a field was added still reads).
     """
-    from benchmark.cameras import CameraSpec, camera_from_dict
+    from benchmark.camera import CameraSpec, camera_from_dict
 
     try:
         camera = camera_from_dict(_without_computed(CameraSpec, spec), source=source)

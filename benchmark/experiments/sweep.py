@@ -1,12 +1,12 @@
 """Every camera × condition on one collection: a tidy AP table and OD50 ± SD per run.
 
-Each (camera, condition) pair is one :func:`benchmark.run.run_camera` call in
+Each (camera, condition) pair is one :func:`benchmark.experiments.run.run_camera` call in
 ``out_dir/runs/<camera>-<condition>/`` (``<camera>-<condition>+<policy>/`` where a
 ``--exposure`` policy changed the camera's own, e.g. ``cam01-day+hdr-16``, so that sweeps
 of several policies share one folder without overwriting). Runs are cached: a run folder whose
 ``results.json`` carries the same key — camera spec sha256, condition, detector sha256
 and input size, collection manifest sha256, seed — is reused, not recomputed.
-A collection subset (:class:`benchmark.run.CollectionSubset`, ``--environments`` /
+A collection subset (:class:`benchmark.experiments.run.CollectionSubset`, ``--environments`` /
 ``--distances``) adds ``subset`` to the key and ``+subset-<hash>`` to the folder name.
 ``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
 only its missing (or stale) runs. Those runs may go to worker processes or a dask cluster
@@ -22,7 +22,7 @@ Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
   environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`).
 
-MTF50 comes from :func:`benchmark.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
+MTF50 comes from :func:`benchmark.measure.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
 (ISO 12233 slanted edge through the camera), ``analytic`` (diffraction × pixel aperture)
 or ``published_group`` (the paper's MTF50 group of a registry camera).
 """
@@ -40,14 +40,14 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
-from benchmark.mtf import MTF50_SOURCES, camera_mtf50
+from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
 from metricscenes.files import write_atomic
 from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
-    from benchmark.cameras.spec import ExposureSpec
+    from benchmark.camera.spec import ExposureSpec
 
 SWEEP_FORMAT = "metricscenes-sweep/1"
 TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
@@ -63,9 +63,9 @@ Progress = Callable[[int, int, str], None]
 
 def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) -> str:
     """Folder name of one run under ``out_dir/runs`` (``exposure_tag``: the overriding
-    exposure policy's :func:`benchmark.exposure.exposure_tag`). Its parts come from camera
-    files and collection manifests, so each must pass :func:`benchmark.run.check_path_name`."""
-    from benchmark.run import check_path_name
+    exposure policy's :func:`benchmark.camera.exposure.exposure_tag`). Its parts come from camera
+    files and collection manifests, so each must pass :func:`benchmark.experiments.run.check_path_name`."""
+    from benchmark.experiments.run import check_path_name
 
     check_path_name(camera_name, "camera name")
     check_path_name(condition, "condition")
@@ -78,7 +78,7 @@ def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
     """What makes two runs interchangeable (the cache key). A camera that sees a window
     of the collection's field adds its geometry (runs made before cameras had their own
     field of view are redone); the registry cameras' keys are unchanged."""
-    from benchmark.run import camera_geometry
+    from benchmark.experiments.run import camera_geometry
 
     key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
            "model_sha256": detector.sha256, "input_size": str(detector.input_size),
@@ -153,7 +153,7 @@ def compute_run(collection, camera, condition: str, detector, run_dir: Path, see
     """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
     backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
     other unit touches. Returns (camera name, condition, results)."""
-    from benchmark import run as run_module
+    from benchmark.experiments import run as run_module
 
     results = run_module.run_camera(collection, camera, condition, detector, run_dir, seed=seed,
                                     save_images=save_images, backend=backend, progress=progress)
@@ -177,7 +177,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         n_resamples: bootstrap resamples of OD50 (over environments).
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
             run advances by all its scenes at once (so does every run on a pool or cluster).
-        mtf_source: ``measured`` | ``analytic`` | ``published_group`` (see :func:`benchmark.mtf.camera_mtf50`).
+        mtf_source: ``measured`` | ``analytic`` | ``published_group`` (see :func:`benchmark.measure.mtf.camera_mtf50`).
         exposure: an :class:`ExposureSpec` replacing every camera's exposure block (None:
             each camera's own); it changes the spec sha256 (the cache key) and tags the
             folders of the runs it changed (:func:`run_name`).
@@ -190,10 +190,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
     """
-    from benchmark import run as run_module
-    from benchmark.camera import camera_window
-    from benchmark.cameras import load_camera
-    from benchmark.exposure import exposure_tag, format_exposure, with_exposure
+    from benchmark.experiments import run as run_module
+    from benchmark.camera.pipeline import camera_window
+    from benchmark.camera import load_camera
+    from benchmark.camera.exposure import exposure_tag, format_exposure, with_exposure
     from metricscenes.backends import check_scheduler, map_units, runs_in_process
     from metricscenes.store import Collection
 
@@ -306,7 +306,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
 
 def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
     """The illuminance-sweep rows of a sweep table with ``base_condition`` and
-    ``illuminance_lux`` columns (the input of :func:`benchmark.spm.spm_illuminance`)."""
+    ``illuminance_lux`` columns (the input of :func:`benchmark.experiments.spm.spm_illuminance`)."""
     parsed = table["condition"].map(parse_illuminance_condition)
     part = table[parsed.notna()].copy()
     part["base_condition"] = [p[0] for p in parsed[parsed.notna()]]

@@ -9,8 +9,8 @@ normalised at DC. The central difference and the 1/4-pixel bins are corrected
 (divided by their sinc responses, as ISO 12233:2017's derivative correction).
 Frequencies are cycles/mm on the sensor along the edge normal.
 
-The camera measurement renders :func:`benchmark.targets.slanted_edge_scene` through the
-same optics, sensor (noise off, quantised) and demosaic as :func:`benchmark.camera.simulate`,
+The camera measurement renders :func:`benchmark.measure.targets.slanted_edge_scene` through the
+same optics, sensor (noise off, quantised) and demosaic as :func:`benchmark.camera.pipeline.simulate`,
 and analyses the luminance 0.3 R + 0.6 G + 0.1 B (ISETCam).
 
 ``measure_mtf50(camera, esfr="isetcam")`` measures as ISETCam did for the paper's MTF50
@@ -29,11 +29,11 @@ import math
 import numpy as np
 import scipy.optimize
 
-from benchmark import exposure, isp, optics, sensor
-from benchmark.calibration import illuminant_gains, illuminant_spectrum
-from benchmark.camera import camera_extent, electron_rate
-from benchmark.cameras.spec import CameraSpec, SensorSpec
-from benchmark.targets import slanted_edge_scene
+from benchmark.camera import exposure, isp, optics, sensor
+from benchmark.camera.calibration import illuminant_gains, illuminant_spectrum
+from benchmark.camera.pipeline import camera_extent, electron_rate
+from benchmark.camera.spec import CameraSpec, SensorSpec
+from benchmark.measure.targets import slanted_edge_scene
 from metricscenes.spectral import WAVELENGTHS_NM
 
 LUMINANCE_WEIGHTS = np.array([0.3, 0.6, 0.1])

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft as sfft
 
-from benchmark.cameras.spec import OpticsSpec
+from benchmark.camera.spec import OpticsSpec
 
 FFT_WORKERS = 2
 _BATCH = 8  # spectra summed per matrix product (memory: 8 × the padded image, complex64)
@@ -149,7 +149,7 @@ def channel_signal(
         optics: the lens.
         pixel_um: pixel pitch, µm (sampling of ``radiance``).
         responsivity: (channels, bands) signal per unit irradiance per band, e.g.
-            electrons·s⁻¹ per W·m⁻²·nm⁻¹ (:func:`benchmark.sensor.channel_responsivity`).
+            electrons·s⁻¹ per W·m⁻²·nm⁻¹ (:func:`benchmark.camera.sensor.channel_responsivity`).
         diffraction: apply the OTF (off: irradiance only, for tests).
 
     Returns:

@@ -6,14 +6,14 @@
     ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
 
 The ``hdr`` exposure policy captures a long and a short raw and merges them before the
-ISP (:mod:`benchmark.hdr`), then tone-maps before the sRGB encoding.
+ISP (:mod:`benchmark.camera.hdr`), then tone-maps before the sRGB encoding.
 
 Geometry: the camera sees its own field, 2·atan(width_px · pixel / 2f) ×
 2·atan(height_px · pixel / 2f), a window of the scene's field centred on the optical
 axis (:func:`camera_window`); a camera whose field exceeds the scene's is refused. The
 13 registry cameras see exactly the reference field, so their window *is* the field.
 A lens with radial distortion (``optics.distortion_k1``, ``distortion_k2``) sees the
-undistorted window its sensor's border maps to, through :mod:`benchmark.distortion`.
+undistorted window its sensor's border maps to, through :mod:`benchmark.camera.distortion`.
 """
 
 from __future__ import annotations
@@ -22,14 +22,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark import distortion as _distortion
-from benchmark import exposure as _exposure
-from benchmark import hdr as _hdr
-from benchmark import isp as _isp
-from benchmark import optics as _optics
-from benchmark import sensor as _sensor
-from benchmark.calibration import calibrate
-from benchmark.cameras.spec import CameraSpec
+from benchmark.camera import distortion as _distortion
+from benchmark.camera import exposure as _exposure
+from benchmark.camera import hdr as _hdr
+from benchmark.camera import isp as _isp
+from benchmark.camera import optics as _optics
+from benchmark.camera import sensor as _sensor
+from benchmark.camera.calibration import calibrate
+from benchmark.camera.spec import CameraSpec
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, centred_extent, extent_within, fov_deg
 from metricscenes.radiance import SpectralScene
 
@@ -132,11 +132,11 @@ def electron_rate(
     the full frame: the camera's own field, :func:`camera_window` of the scene's
     field); the window must be sampled at the camera's pixel pitch. With lens
     distortion ``extent`` is in the sensor's (distorted) coordinates and the scene is
-    sampled through the distortion (:func:`benchmark.distortion.resample_distorted`).
+    sampled through the distortion (:func:`benchmark.camera.distortion.resample_distorted`).
     """
     radiance = sensor_radiance(scene, camera, shape_px=shape_px, extent=extent)
     # The fused fast path: optics and the sensor's spectral integration in one pass over
-    # the bands (benchmark.optics.channel_signal); optical_image + the sensor's
+    # the bands (benchmark.camera.optics.channel_signal); optical_image + the sensor's
     # signal_from_irradiance is the plain path it is held equal to (tests/test_camera_speed_paths.py).
     resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))
     return _optics.channel_signal(

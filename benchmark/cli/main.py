@@ -10,9 +10,10 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from benchmark.cli_cameras import app as cameras_app
+from benchmark.cli.cameras import app as cameras_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
-from benchmark import cli_detect, cli_leaderboard, compare
+from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
+from benchmark.experiments import compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
 
@@ -59,10 +60,10 @@ def run(
     class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
 ) -> None:
     """Simulate one camera on a collection, detect cars, print AP per distance."""
-    from benchmark.cameras import load_camera
+    from benchmark.camera import load_camera
     from benchmark.detectors import DetectorError, load_detector
-    from benchmark.exposure import format_exposure, parse_exposure, with_exposure
-    from benchmark.run import check_out_dir, run_camera, subset_collection
+    from benchmark.camera.exposure import format_exposure, parse_exposure, with_exposure
+    from benchmark.experiments.run import check_out_dir, run_camera, subset_collection
     from metricscenes.store import Collection, CollectionError
 
     try:
@@ -119,11 +120,11 @@ def sweep(
     scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
-    from benchmark import sweep as sweep_module
-    from benchmark.cameras import camera_names, load_camera
+    from benchmark.experiments import sweep as sweep_module
+    from benchmark.camera import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
-    from benchmark.exposure import format_exposure, parse_exposure
-    from benchmark.run import check_out_dir, subset_collection
+    from benchmark.camera.exposure import format_exposure, parse_exposure
+    from benchmark.experiments.run import check_out_dir, subset_collection
     from metricscenes.backends import BackendError, runs_in_process, threads_per_unit
     from metricscenes.store import Collection, CollectionError
 
@@ -185,7 +186,7 @@ def report(
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="HTML page (default RESULTS_DIR/report.html)")] = None,
 ) -> None:
     """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips."""
-    from benchmark.report import report as write_report
+    from benchmark.experiments.report import report as write_report
 
     if not results_dir.is_dir():
         fail(f"results folder not found: {results_dir}")

@@ -1,7 +1,7 @@
 """One camera on one collection under one condition: images → detections → AP per distance.
 
 The chain, each stage from its own module: collection radiance (metricscenes store)
-→ :func:`benchmark.camera.simulate` (optics, sensor, exposure, ISP) → detector →
+→ :func:`benchmark.camera.pipeline.simulate` (optics, sensor, exposure, ISP) → detector →
 :func:`benchmark.scoring.ap_by_distance`. Outputs, in the results folder:
 
 - ``results.json``: camera, condition, detector, collection, AP/AP50 per distance, OD50;
@@ -75,8 +75,8 @@ def camera_geometry(collection, camera) -> dict | None:
     """Where the camera sees less than the collection's field: its field and window, as
     recorded in results.json (``camera_geometry``) and in the sweep cache key; None for a
     camera that sees the whole field (the 13 registry cameras), whose results keep their
-    bytes. :class:`benchmark.camera.FieldOfViewError` for a camera that sees more."""
-    from benchmark.camera import camera_window
+    bytes. :class:`benchmark.camera.pipeline.FieldOfViewError` for a camera that sees more."""
+    from benchmark.camera.pipeline import camera_window
 
     field = collection_field(collection)
     return _geometry_record(camera, field, camera_window(camera, field))
@@ -229,7 +229,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     only when the run succeeded: a damaged scene or a broken model met halfway leaves
     ``out_dir`` as it was (the folders the run created are removed).
     """
-    from benchmark.camera import camera_window
+    from benchmark.camera.pipeline import camera_window
 
     out_dir = check_out_dir(out_dir)  # before anything is written
     field = collection_field(collection)
@@ -266,7 +266,7 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     collection's ``field`` the camera samples (and its ground truth follows)."""
     from PIL import Image
 
-    from benchmark.camera import lens_mapping, simulate
+    from benchmark.camera.pipeline import lens_mapping, simulate
     from benchmark.detectors import coco_category_id
     from benchmark.scoring import ap_by_distance, od50
     from metricscenes import __version__

@@ -1,6 +1,6 @@
 """``benchmark detect``: run a COCO detector on image files and print its detections.
 
-Mounted by the lead's ``benchmark/cli.py`` through :func:`register`.
+Mounted by the lead's ``benchmark/cli/main.py`` through :func:`register`.
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ from pydantic import (
     model_validator,
 )
 
-from benchmark.distortion import check_monotonic, undistorted_bounds
+from benchmark.camera.distortion import check_monotonic, undistorted_bounds
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
     REFERENCE_ACTIVE_WIDTH_MM,
@@ -104,7 +104,7 @@ class OpticsSpec(BaseModel):
     cos4_falloff: bool = False
     distortion_k1: float = Field(0.0, ge=-1.0, le=1.0)
     """Brown–Conrady radial distortion, r² term (normalised image coordinates x/f;
-    negative: barrel), :mod:`benchmark.distortion`."""
+    negative: barrel), :mod:`benchmark.camera.distortion`."""
     distortion_k2: float = Field(0.0, ge=-1.0, le=1.0)
     """Brown–Conrady radial distortion, r⁴ term."""
 
@@ -136,7 +136,7 @@ class SensorSpec(BaseModel):
     active_height_mm: float = Field(REFERENCE_ACTIVE_HEIGHT_MM, gt=0.0, le=50.0)
     cfa: Literal["RGGB"] = "RGGB"
     qe: str = Field("imx363_qe.csv", min_length=1, max_length=255)
-    """Packaged CSV name (``benchmark/cameras/data``), else a relative path from the spec
+    """Packaged CSV name (``benchmark/camera/data``), else a relative path from the spec
     file's folder (no absolute path, no ``..``); columns
     ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``."""
     fill_factor: float = Field(1.0, gt=0.0, le=1.0)
@@ -245,7 +245,7 @@ class ExposureSpec(BaseModel):
     ``mean_level``: the mean voltage of the central region at ``level`` of the swing;
     ``percentile``: the ``percentile``-th percentile of the central region at ``level``
     of the swing; ``hdr``: a long and a short exposure ``hdr_ratio`` apart, merged
-    before the ISP (:mod:`benchmark.hdr`); ``fixed``: ``exposure_s``. All but ``fixed``
+    before the ISP (:mod:`benchmark.camera.hdr`); ``fixed``: ``exposure_s``. All but ``fixed``
     are capped at ``max_exposure_s``."""
 
     model_config = _STRICT
@@ -323,7 +323,7 @@ class ISPSpec(BaseModel):
     """``checker_srgb``: the ColorChecker-fitted matrix from white-balanced camera RGB to
     linear sRGB (rows sum to 1; 1.0 = the ADC white). ``iset_mcc``: ISETCam's 'MCC
     optimized' sensor conversion to XYZ, then display rendering scaled to the image's
-    maximum (:func:`benchmark.isp.iset_render`)."""
+    maximum (:func:`benchmark.camera.isp.iset_render`)."""
 
     @model_serializer(mode="wrap")
     def _omit_default_color_transform(self, handler):
@@ -375,7 +375,7 @@ class CameraSpec(BaseModel):
     @property
     def tan_half_width(self) -> float:
         """tan of half the horizontal field: half the pixel array's width over the focal
-        length (the sensor's half-width in distorted coordinates, :mod:`benchmark.distortion`)."""
+        length (the sensor's half-width in distorted coordinates, :mod:`benchmark.camera.distortion`)."""
         return self.sensor.array_width_mm / 2.0 / self.optics.focal_length_mm
 
     @property
@@ -442,7 +442,7 @@ def isp_preset(name: str) -> ISPSpec:
     (``imgproc/imageSensorTransform.m``), no white balance, XYZ to linear display RGB
     scaled to the image's maximum (``displays/displayRender.m``). ISETCam's MTF
     (``metrics/ISO/ieISO12233.m``) reads the demosaicked 'sensor space', before the
-    colour transform: see :func:`benchmark.mtf.measure_mtf50` and docs/camera.md.
+    colour transform: see :func:`benchmark.measure.mtf.measure_mtf50` and docs/camera.md.
     """
     if name == "default":
         return ISPSpec()

@@ -8,7 +8,7 @@ IS&T) and Debevec & Malik (1997, "Recovering high dynamic range radiance maps fr
 photographs", SIGGRAPH), with the response known to be linear and a hard switch as
 the weighting. The merged mosaic stays on the long exposure's scale and in DN (black
 level included, float32, up to r × the white level), so it goes through the ISP's
-colour path like a single raw; :func:`benchmark.isp.tone_curve_reinhard` brings it to
+colour path like a single raw; :func:`benchmark.camera.isp.tone_curve_reinhard` brings it to
 the 8-bit range (docs/camera.md, "Acquisition policies").
 """
 
@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from benchmark.cameras.spec import SensorSpec
-from benchmark.sensor import saturation_electrons, signal_volts_per_electron
+from benchmark.camera.spec import SensorSpec
+from benchmark.camera.sensor import saturation_electrons, signal_volts_per_electron
 
 SWITCH_FRACTION = 0.95
 """The long exposure is used below this fraction of the raw's saturation: a margin so

@@ -13,7 +13,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from benchmark.cameras.spec import PACKAGE_DATA_DIR, SPEC_DIR_CONTEXT, CameraSpec
+from benchmark.camera.spec import PACKAGE_DATA_DIR, SPEC_DIR_CONTEXT, CameraSpec
 
 DATA_DIR = PACKAGE_DATA_DIR
 

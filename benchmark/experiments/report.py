@@ -1,7 +1,7 @@
 """``benchmark report``: one self-contained HTML page from a sweep or a single run folder.
 
 The page holds AP-vs-distance curves per condition (one line per camera), the System
-Performance Maps and OD50 vs MTF50 (:mod:`benchmark.spm`; sweep folders with two or
+Performance Maps and OD50 vs MTF50 (:mod:`benchmark.experiments.spm`; sweep folders with two or
 more MTF50 values only), a table (camera, MTF50, condition, OD50 ± SD, AP per
 distance), and per distance a strip of camera images, cropped around the car at the
 same field of view for every camera, with the ground-truth box (green) and the best
@@ -27,9 +27,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from benchmark import spm  # noqa: E402
-from benchmark.mtf import camera_mtf50  # noqa: E402
-from benchmark.sweep import (  # noqa: E402
+from benchmark.experiments import spm  # noqa: E402
+from benchmark.measure.mtf import camera_mtf50  # noqa: E402
+from benchmark.experiments.sweep import (  # noqa: E402
     TABLE_COLUMNS,
     illuminance_table,
     load_sweep,
@@ -266,7 +266,7 @@ def _page(meta: dict, body: str) -> str:
 def _run_mtf50(cam: dict) -> tuple[float, str]:
     """MTF50 of a run's camera from the spec recorded in its results.json (NaN, "none":
     no spec, or no source gave one)."""
-    from benchmark.cameras import camera_from_dict
+    from benchmark.camera import camera_from_dict
 
     spec = json.loads(json.dumps(cam.get("spec") or {}))
     spec.get("sensor", {}).pop("width_px", None), spec.get("sensor", {}).pop("height_px", None)  # computed fields

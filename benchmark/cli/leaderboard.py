@@ -1,6 +1,6 @@
 """``benchmark submit``, ``benchmark leaderboard`` and ``benchmark schema``.
 
-Mounted by ``benchmark/cli.py`` through :func:`register`. Every refusal is one line on
+Mounted by ``benchmark/cli/main.py`` through :func:`register`. Every refusal is one line on
 stderr and exit code 2; ``--check`` and refused submissions never touch the leaderboard.
 """
 

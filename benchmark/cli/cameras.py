@@ -14,7 +14,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from benchmark.cameras import CameraSpec, list_cameras, load_camera
+from benchmark.camera import CameraSpec, list_cameras, load_camera
 from metricscenes.cli_support import fail
 
 app = typer.Typer(help="The camera registry: list, show, measure MTF50.", no_args_is_help=True)
@@ -64,7 +64,7 @@ def show_command(
 ) -> None:
     """Show a camera's resolved spec (defaults filled in) and what it implies: field of
     view, IFOV, Nyquist, saturation, dynamic range, SNR at 100 lux, warnings."""
-    from benchmark.cameras.figures import camera_figures, camera_warnings, figure_rows
+    from benchmark.camera.figures import camera_figures, camera_warnings, figure_rows
 
     cam = _load([name])[0]
     try:
@@ -109,8 +109,8 @@ def mtf_command(
         "and MTF50 rule on its 21° edge)."),
 ) -> None:
     """Measure MTF50 (ISO 12233 e-SFR through optics + sensor + demosaic)."""
-    from benchmark.cameras.spec import isp_preset
-    from benchmark.mtf import measure_mtf50, mtf50_analytic_cy_per_mm, mtf_readings
+    from benchmark.camera.spec import isp_preset
+    from benchmark.measure.mtf import measure_mtf50, mtf50_analytic_cy_per_mm, mtf_readings
 
     cams = _load(names or [])
     if esfr not in ("iso", "isetcam"):
@@ -179,13 +179,13 @@ def _cell(value: float | None, fmt: str) -> str:
 
 
 def _plot(curves: list[dict], path: Path) -> None:
-    """The curves with Nyquist, MTF50/30/10 and a cycles/pixel axis (:func:`benchmark.mtf.mtf_figure`)."""
+    """The curves with Nyquist, MTF50/30/10 and a cycles/pixel axis (:func:`benchmark.measure.mtf.mtf_figure`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from benchmark.mtf import mtf_figure
+    from benchmark.measure.mtf import mtf_figure
 
     fig = mtf_figure(curves)
     try:

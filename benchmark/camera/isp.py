@@ -2,10 +2,10 @@
 
 Order (as dcraw and most camera ISPs): black-level subtraction and normalisation →
 white-balance gains on the mosaic → demosaic (Malvar, He & Cutler 2004, ICASSP, by
-default, in float32 by :mod:`benchmark.demosaic`; bilinear option, colour-demosaicing)
+default, in float32 by :mod:`benchmark.camera.demosaic`; bilinear option, colour-demosaicing)
 → 3×3 colour matrix to linear sRGB → sRGB transfer curve (IEC 61966-2-1) → 8 bit.
 
-The ISP knows its sensor through a :class:`benchmark.calibration.Calibration` (colour
+The ISP knows its sensor through a :class:`benchmark.camera.calibration.Calibration` (colour
 matrices, white-balance gains), fitted once from the sensor's spectra and handed in:
 it never reads spectra itself.
 """
@@ -16,10 +16,10 @@ import colour
 import colour_demosaicing
 import numpy as np
 
-from benchmark.calibration import Calibration
-from benchmark.cameras.spec import ISPSpec, SensorSpec
-from benchmark.demosaic import malvar2004
-from benchmark.sensor import bayer_sites
+from benchmark.camera.calibration import Calibration
+from benchmark.camera.spec import ISPSpec, SensorSpec
+from benchmark.camera.demosaic import malvar2004
+from benchmark.camera.sensor import bayer_sites
 
 
 def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
@@ -50,7 +50,7 @@ def apply_gains(mosaic: np.ndarray, gains: np.ndarray, cfa: str = "RGGB") -> np.
 
 def demosaic(mosaic: np.ndarray, method: str = "malvar2004", cfa: str = "RGGB") -> np.ndarray:
     """(rows, cols) mosaic → (rows, cols, 3) float32 RGB (``malvar2004``: the float32
-    implementation in :mod:`benchmark.demosaic`; ``bilinear``: colour-demosaicing)."""
+    implementation in :mod:`benchmark.camera.demosaic`; ``bilinear``: colour-demosaicing)."""
     if method == "malvar2004":
         return malvar2004(mosaic, cfa)
     elif method == "bilinear":
@@ -111,7 +111,7 @@ def iset_render(rgb_sensor: np.ndarray, mcc_matrix: np.ndarray) -> np.ndarray:
     """ISETCam's default rendering of demosaicked sensor RGB (its 'sensor space') to
     linear display RGB in [0, 1] (float32), as ``ipCompute`` with the default ``ip``:
 
-    1. XYZ = sensor RGB × ``mcc_matrix`` (:func:`benchmark.calibration.iset_mcc_matrix`), clipped at 0
+    1. XYZ = sensor RGB × ``mcc_matrix`` (:func:`benchmark.camera.calibration.iset_mcc_matrix`), clipped at 0
        (``imgproc/imageSensorCorrection.m``);
     2. illuminant correction 'None': nothing (``imgproc/imageIlluminantCorrection.m``);
     3. XYZ to linear display RGB, clipped at 0, divided by the image's maximum

@@ -1,8 +1,8 @@
 """A synthetic run folder (results.json, detections.json, groundtruth.json), for tests and examples.
 
-Ground truth and detections come from :func:`benchmark.scoring.synthetic.synthetic_collection`
+Ground truth and detections come from :func:`synthetic_scoring.synthetic_collection`
 (seeded; AP falls with distance), scored with :func:`benchmark.scoring.ap_by_distance`, and
-written in :mod:`benchmark.run`'s results format, as if ``camera`` had run on ``manifest``.
+written in :mod:`benchmark.experiments.run`'s results format, as if ``camera`` had run on ``manifest``.
 """
 
 from __future__ import annotations
@@ -25,10 +25,10 @@ def write_synthetic_run(
     distances_m=None,
 ) -> dict:
     """Write a run folder for ``camera`` (a CameraSpec) on ``manifest`` (a Manifest); returns results."""
-    from benchmark.run import RESULTS_FORMAT, AP_SCORE_THRESHOLD, _finite_or_none
+    from benchmark.experiments.run import RESULTS_FORMAT, AP_SCORE_THRESHOLD, _finite_or_none
     from benchmark.detectors import registry
     from benchmark.scoring import ap_by_distance, od50
-    from benchmark.scoring.synthetic import synthetic_collection
+    from synthetic_scoring import synthetic_collection
     from metricscenes import __version__
 
     out = Path(out_dir)

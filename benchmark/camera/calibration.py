@@ -11,7 +11,7 @@ from the spec (ISETCam keeps it in the image processor's 'sensor conversion').
 - the white-balance gains of a known illuminant (:func:`illuminant_gains`).
 
 The matrices depend on the spectral data only (QE and IR cut, not pixel size), so they
-are cached by QE file. The ISP (:mod:`benchmark.isp`) receives a :class:`Calibration`
+are cached by QE file. The ISP (:mod:`benchmark.camera.isp`) receives a :class:`Calibration`
 and never reads the sensor's spectra itself.
 """
 
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import colour
 import numpy as np
 
-from benchmark.cameras.spec import ISPSpec, SensorSpec
-from benchmark.sensor import channel_responsivity
+from benchmark.camera.spec import ISPSpec, SensorSpec
+from benchmark.camera.sensor import channel_responsivity
 from metricscenes.photometry import cie_1931_cmfs
 from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.cameras.spec import SensorSpec
+from benchmark.camera.spec import SensorSpec
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j, resample_spectrum
 
 CHANNELS = ("r", "g", "b")
@@ -74,7 +74,7 @@ def signal_from_irradiance(irradiance: np.ndarray, wavelengths_nm: np.ndarray, s
     """Noise-free signal per channel (3, rows, cols), electrons·s⁻¹, of a spectral
     irradiance (rows, cols, bands) in W·m⁻²·nm⁻¹ (an optical image's): Σ_λ r_c(λ)·E(λ)
     with :func:`channel_responsivity`. The plain path; the camera's fused fast path
-    (``benchmark.optics.channel_signal``) is held equal to it."""
+    (``benchmark.camera.optics.channel_signal``) is held equal to it."""
     resp = channel_responsivity(sensor, np.asarray(wavelengths_nm, float))
     return np.einsum("hwb,cb->chw", np.asarray(irradiance, np.float64), resp).astype(np.float32)
 

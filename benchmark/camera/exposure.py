@@ -6,7 +6,7 @@ central region, t ≤ 16 ms (60 frames/s). Voltages here are signal volts at the
 (conversion gain × analog gain), without the black-level offset.
 
 Besides the reference (``auto_peak``) a run may choose ``mean_level``, ``percentile``,
-``hdr`` (two exposures, :mod:`benchmark.hdr`) or ``fixed``; :func:`parse_exposure` reads
+``hdr`` (two exposures, :mod:`benchmark.camera.hdr`) or ``fixed``; :func:`parse_exposure` reads
 the compact syntax of ``benchmark run/sweep --exposure`` (docs/camera.md,
 "Acquisition policies").
 """
@@ -20,8 +20,8 @@ from typing import NamedTuple
 import numpy as np
 from pydantic import ValidationError
 
-from benchmark.cameras.spec import ExposureSpec, SensorSpec
-from benchmark.sensor import signal_volts_per_electron
+from benchmark.camera.spec import ExposureSpec, SensorSpec
+from benchmark.camera.sensor import signal_volts_per_electron
 
 EXPOSURE_SYNTAX = ("auto_peak | mean_level | percentile:P | hdr[:RATIO] | fixed:SECONDS, "
                    "each but fixed with an optional @LEVEL")

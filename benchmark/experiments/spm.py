@@ -172,7 +172,7 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     extrapolations (the paper's outlier, Fig. 7A); they are drawn hollow, at the top of
     the axes when they lie above it, and left out of the fit, so that one camera whose AP
     never falls to 0.5 in the measured range cannot set the slope. With ``censored`` and
-    ``bound_m`` columns (:func:`benchmark.sweep.with_censoring`, as the report passes) the
+    ``bound_m`` columns (:func:`benchmark.experiments.sweep.with_censoring`, as the report passes) the
     censored OD50s are drawn as hollow triangles at their bound instead — ▲ at the farthest
     distance ("> 200 m", a lower bound), ▼ at the nearest ("< 25 m") — and the legend says so.
     """

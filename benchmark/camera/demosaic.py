@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from benchmark.sensor import bayer_sites
+from benchmark.camera.sensor import bayer_sites
 
 _PAD = 2  # the kernels' radius
 

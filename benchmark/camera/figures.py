@@ -4,15 +4,15 @@ makes unreachable). ``benchmark cameras show`` prints them (docs/camera.md, "Fie
 view and geometry", "What a spec implies").
 
 Every figure is computed from the spec with the pipeline's own formulas: saturation by
-:func:`benchmark.sensor.saturation_electrons`, the reference signal by
-:func:`benchmark.camera.electron_rate` on a uniform scene.
+:func:`benchmark.camera.sensor.saturation_electrons`, the reference signal by
+:func:`benchmark.camera.pipeline.electron_rate` on a uniform scene.
 """
 
 from __future__ import annotations
 
 import math
 
-from benchmark.cameras.spec import MAX_CAPTURE_GIB, CameraSpec
+from benchmark.camera.spec import MAX_CAPTURE_GIB, CameraSpec
 
 REFERENCE_ILLUMINANCE_LUX = 100.0
 """Illuminance of the SNR reference: a 18 % grey Lambertian surface lit by 100 lux of D65."""
@@ -32,8 +32,8 @@ def reference_signal_e_per_s(camera: CameraSpec) -> float:
     surface under 100 lux of D65 (luminance 0.18 × 100 / π cd/m²): the pipeline's optics
     and sensor response on a uniform scene, diffraction off (it does not change a
     uniform field)."""
-    from benchmark.camera import electron_rate
-    from benchmark.calibration import illuminant_spectrum
+    from benchmark.camera.pipeline import electron_rate
+    from benchmark.camera.calibration import illuminant_spectrum
     from metricscenes.geometry import REFERENCE_EXTENT
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.radiance import SpectralScene
@@ -48,7 +48,7 @@ def reference_signal_e_per_s(camera: CameraSpec) -> float:
 
 def camera_figures(camera: CameraSpec) -> dict:
     """What the spec implies, as a JSON-ready dict (units in the keys)."""
-    from benchmark.sensor import saturation_electrons, signal_volts_per_electron
+    from benchmark.camera.sensor import saturation_electrons, signal_volts_per_electron
 
     s = camera.sensor
     volts_per_e = signal_volts_per_electron(s)
@@ -94,7 +94,7 @@ def camera_figures(camera: CameraSpec) -> dict:
 
 def camera_warnings(camera: CameraSpec, figures: dict | None = None) -> list[str]:
     """One line per thing the spec implies but does not say."""
-    from benchmark.camera import camera_extent
+    from benchmark.camera.pipeline import camera_extent
     from metricscenes.geometry import REFERENCE_EXTENT, extent_within, fov_deg
 
     f = figures or camera_figures(camera)

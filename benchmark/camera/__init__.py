@@ -1,0 +1,19 @@
+"""The camera wing: specifications and the registry of the paper's 13 cameras (here),
+the stages (optics, distortion, sensor, exposure, hdr, isp, demosaic, calibration) and
+the pipeline that chains them (:mod:`benchmark.camera.pipeline`)."""
+
+from benchmark.camera.registry import DATA_DIR, camera_from_dict, camera_names, list_cameras, load_camera
+from benchmark.camera.spec import CameraSpec, ExposureSpec, ISPSpec, OpticsSpec, SensorSpec
+
+__all__ = [
+    "DATA_DIR",
+    "CameraSpec",
+    "ExposureSpec",
+    "ISPSpec",
+    "OpticsSpec",
+    "SensorSpec",
+    "camera_from_dict",
+    "camera_names",
+    "list_cameras",
+    "load_camera",
+]

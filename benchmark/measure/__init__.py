@@ -1,0 +1,1 @@
+"""Measurement of a camera: test targets and the ISO 12233 slanted-edge MTF."""
