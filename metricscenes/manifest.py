@@ -90,6 +90,15 @@ class RenderSettings(_Strict):
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral"] = "scalar_spectral"
 
 
+class StoreSettings(_Strict):
+    """How radiance is stored (``metricscenes.store.write_radiance``). Without ``store``
+    every value is stored exactly (lossless)."""
+
+    mantissa_bits: Int = Field(
+        ge=1, le=22, description="float32 mantissa bits kept (of 23), rounded to nearest (BitRound): relative "
+        "error at most 2^-(mantissa_bits+1); see docs/performance.md, 'Store size', for the width to choose")
+
+
 class IlluminanceSweep(_Strict):
     """Conditions ``<base>@<level>lux``: the base condition with its ambient group scaled
     so that the horizontal illuminance at the camera is ``level`` lux (the paper's
@@ -130,6 +139,7 @@ class Manifest(_Strict):
     light_groups: tuple[Literal[LIGHT_GROUPS], ...] = Field(min_length=1)  # type: ignore[valid-type]
     conditions: dict[str, dict[str, Float]] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
+    store: StoreSettings | None = None
 
     @field_validator("light_groups")
     @classmethod
@@ -184,7 +194,8 @@ class Manifest(_Strict):
 
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
-        return canonical_sha256(self.model_dump(mode="json"))
+        # store came after the published collections: left out while unset, so their sha256 stand
+        return canonical_sha256(self.model_dump(mode="json", exclude={"store"} if self.store is None else None))
 
     def largest_film_px(self) -> int:
         """Upper bound on the pixels of the largest film a unit renders: a plate (or a

@@ -175,18 +175,39 @@ def write_atomic(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
+def round_mantissa(values: np.ndarray, mantissa_bits: int) -> np.ndarray:
+    """float32 values rounded to nearest (ties to even) with ``mantissa_bits`` of their 23
+    explicit mantissa bits kept: numcodecs' BitRound (Klöwer et al. 2021, "Compressing
+    atmospheric data into its real information content", Nat. Comput. Sci. 1, 713-724).
+
+    The relative error of a normal value is at most 2^-(mantissa_bits + 1) (its RMS over
+    many values about 2^-mantissa_bits / sqrt(12)); zeros stay zero and the sign is kept.
+    The zeroed low bits are what makes the chunk compress."""
+    from numcodecs import BitRound
+
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    return np.asarray(BitRound(keepbits=mantissa_bits).encode(a)).view(np.float32)
+
+
 def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,
-                   extent: TanExtent, extra_attrs: dict | None = None) -> str:
-    """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`:
-    lossless); return its sha256."""
+                   extent: TanExtent, extra_attrs: dict | None = None, mantissa_bits: int | None = None) -> str:
+    """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`);
+    return the sha256 of the values stored.
+
+    ``mantissa_bits`` (the manifest's ``store.mantissa_bits``; None: lossless) rounds the
+    values first (:func:`round_mantissa`), so the sha256 is that of the rounded values, and
+    records the width in the array's ``mantissa_bits`` attribute."""
     import zarr
 
     cube = np.ascontiguousarray(cube, dtype=np.float32)
+    if mantissa_bits is not None:
+        cube = round_mantissa(cube, mantissa_bits)
     attrs = {
         "units": RADIANCE_UNITS,
         "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
         "extent_tan": list(extent.as_tuple()),
         "light_group": light_group,
+        **({} if mantissa_bits is None else {"mantissa_bits": mantissa_bits}),
         **(extra_attrs or {}),
     }
     arr = zarr.create_array(
