@@ -18,6 +18,17 @@ and ``light_group``. A light group that puts no light in a unit (e.g. street lig
 on a road without any) has no array: it reads as zero. Which arrays a unit has is
 what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
 
+Codecs: radiance chunks are encoded as bytes (little-endian) + Blosc (zstd level 1, byte
+shuffle, the chunk as one block): codecs of the zarr v3 core specification, lossless, so
+the values and their sha256 are the ones rendered (:data:`RADIANCE_COMPRESSORS`).
+Collections written before with zarr's default (bytes + zstd level 0) read the same:
+zarr takes each array's chain from its ``zarr.json``. A manifest's ``store:
+{mantissa_bits: N}`` rounds radiance to N of float32's 23 mantissa bits before the write
+(BitRound, :func:`round_mantissa`): at most 2^-(N+1) relative error per value (RMS about
+2^-N / sqrt(12)); the sha256 recorded is the rounded values', and such arrays carry a
+``mantissa_bits`` attribute. Sizes, times and the error against the render's own noise:
+docs/performance.md, "Store size".
+
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
 deleted chunk is an error, never wrong numbers or fill-value zeros. Collections written
