@@ -101,6 +101,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     env = unit.environment
     parts = scene_mod.environment_parts(env)
     record: dict = {"unit": unit.key, "kind": unit.kind, "arrays": {}}
+    mantissa_bits = manifest.store.mantissa_bits if manifest.store else None  # None: lossless
     started = time.perf_counter()
     if unit.kind == "plate":
         groups = [g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
@@ -122,7 +123,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
                                   max_depth=manifest.render.max_depth)
         sha = write_radiance(root, kind, unit.key, group, render_radiance(sd, spp), extent,
-                             {"spp": spp, "seed": unit.seed})
+                             {"spp": spp, "seed": unit.seed}, mantissa_bits)
         record["arrays"][f"{kind}/{unit.key}/{group}"] = sha
         if unit.kind == "plate":
             irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)

@@ -126,6 +126,15 @@ def parse_illuminance_condition(condition: str) -> tuple[str, float] | None:
     return (match["base"], float(match["lux"])) if match else None
 
 
+class StoreSettings(_Strict):
+    """How radiance is stored (``metricscenes.store.write_radiance``). Without ``store``
+    every value is stored exactly (lossless)."""
+
+    mantissa_bits: Int = Field(
+        ge=1, le=22, description="float32 mantissa bits kept (of 23), rounded to nearest (BitRound): relative "
+        "error at most 2^-(mantissa_bits+1); see docs/performance.md, 'Store size', for the width to choose")
+
+
 class IlluminanceSweep(_Strict):
     """Conditions ``<base>@<level>lux``: the base condition with its ambient group scaled
     so that the horizontal illuminance at the camera is ``level`` lux (the paper's
@@ -166,6 +175,7 @@ class Manifest(_Strict):
     light_groups: tuple[Literal[LIGHT_GROUPS], ...] = Field(min_length=1)  # type: ignore[valid-type]
     conditions: dict[str, dict[str, Float]] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
+    store: StoreSettings | None = None
 
     @field_validator("light_groups")
     @classmethod
@@ -283,19 +293,23 @@ def canonical_sha256(data) -> str:
     return hashlib.sha256(canonical.encode()).hexdigest()
 
 
-# Fields added after collections were first published, omitted from the hash while unset
-# so that every earlier manifest keeps its sha256 (pinned by protocols and collections).
-HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"),)
+# Fields added after collections were first published (paths into the manifest's JSON
+# form), omitted from the hash while unset so that every earlier manifest keeps its
+# sha256 (pinned by protocols and collections).
+HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",))
 
 
 def manifest_sha256(data: dict) -> str:
     """sha256 of a manifest's JSON form (``Manifest.model_dump(mode="json")``, or the
     copy in a collection's resolved manifest): :func:`canonical_sha256` with the
-    :data:`HASHED_ONLY_WHEN_SET` fields left out where they are unset."""
+    :data:`HASHED_ONLY_WHEN_SET` fields left out where they are unset (None or absent)."""
     data = {key: dict(value) if isinstance(value, dict) else value for key, value in data.items()}
-    for section, key in HASHED_ONLY_WHEN_SET:
-        if isinstance(data.get(section), dict) and data[section].get(key) is None:
-            data[section].pop(key, None)
+    for *sections, key in HASHED_ONLY_WHEN_SET:
+        holder = data
+        for section in sections:
+            holder = holder.get(section) if isinstance(holder, dict) else None
+        if isinstance(holder, dict) and holder.get(key) is None:
+            holder.pop(key, None)
     return canonical_sha256(data)
 
 

@@ -21,6 +21,17 @@ and ``light_group``. A light group that puts no light in a unit (e.g. street lig
 on a road without any) has no array: it reads as zero. Which arrays a unit has is
 what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
 
+Codecs: radiance chunks are encoded as bytes (little-endian) + Blosc (zstd level 1, byte
+shuffle, the chunk as one block): codecs of the zarr v3 core specification, lossless, so
+the values and their sha256 are the ones rendered (:data:`RADIANCE_COMPRESSORS`).
+Collections written before with zarr's default (bytes + zstd level 0) read the same:
+zarr takes each array's chain from its ``zarr.json``. A manifest's ``store:
+{mantissa_bits: N}`` rounds radiance to N of float32's 23 mantissa bits before the write
+(BitRound, :func:`round_mantissa`): at most 2^-(N+1) relative error per value (RMS about
+2^-N / sqrt(12)); the sha256 recorded is the rounded values', and such arrays carry a
+``mantissa_bits`` attribute. Sizes, times and the error against the render's own noise:
+docs/performance.md, "Store size".
+
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
 deleted chunk is an error, never wrong numbers or fill-value zeros. Collections written
@@ -55,6 +66,19 @@ REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
 # Arrays are always written with their chunk, even an all-zero one, so that a missing
 # chunk file is damage (zarr would otherwise read it as fill-value zeros).
 WRITE_CONFIG = {"write_empty_chunks": True}
+# Radiance chunks: bytes (little-endian), then Blosc: byte shuffle and zstd level 1 over the
+# whole chunk as one block; all codecs of the zarr v3 core specification (any v3 reader
+# decodes them). Monte Carlo noise fills the low mantissa bytes, which no lossless coder
+# shrinks; the shuffle puts the sign-exponent bytes of all values together, where they
+# compress well. Against zarr's default (bytes + zstd level 0, what collections were written
+# with before: they still read) 6 % smaller, written 3x faster, read as fast (measured by
+# benchmarks/store_codecs.py: docs/performance.md, "Store size").
+RADIANCE_COMPRESSORS = ({"name": "blosc", "configuration": {"cname": "zstd", "clevel": 1, "shuffle": "shuffle",
+                                                             "typesize": 4, "blocksize": 2**30}},)
+# c-blosc 1 refuses buffers of 2 GiB or more: such a chunk (a film the manifest's bounds allow
+# only on a very large machine) is written with zarr's default zstd instead.
+BLOSC_MAX_BYTES = 2**31 - 64
+ZARR_DEFAULT_COMPRESSORS = ({"name": "zstd", "configuration": {"level": 0, "checksum": False}},)
 
 
 class CollectionError(ValueError):
@@ -162,22 +186,45 @@ def collection_containing(path: str | Path) -> Path | None:
     return None
 
 
+def round_mantissa(values: np.ndarray, mantissa_bits: int) -> np.ndarray:
+    """float32 values rounded to nearest (ties to even) with ``mantissa_bits`` of their 23
+    explicit mantissa bits kept: numcodecs' BitRound (Klöwer et al. 2021, "Compressing
+    atmospheric data into its real information content", Nat. Comput. Sci. 1, 713-724).
+
+    The relative error of a normal value is at most 2^-(mantissa_bits + 1) (its RMS over
+    many values about 2^-mantissa_bits / sqrt(12)); zeros stay zero and the sign is kept.
+    The zeroed low bits are what makes the chunk compress."""
+    from numcodecs import BitRound
+
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    return np.asarray(BitRound(keepbits=mantissa_bits).encode(a)).view(np.float32)
+
+
 def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,
-                   extent: TanExtent, extra_attrs: dict | None = None) -> str:
-    """Write one radiance cube as a single-chunk zarr array; return its sha256."""
+                   extent: TanExtent, extra_attrs: dict | None = None, mantissa_bits: int | None = None) -> str:
+    """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`);
+    return the sha256 of the values stored.
+
+    ``mantissa_bits`` (the manifest's ``store.mantissa_bits``; None: lossless) rounds the
+    values first (:func:`round_mantissa`), so the sha256 is that of the rounded values, and
+    records the width in the array's ``mantissa_bits`` attribute."""
     import zarr
 
     cube = np.ascontiguousarray(cube, dtype=np.float32)
+    if mantissa_bits is not None:
+        cube = round_mantissa(cube, mantissa_bits)
     attrs = {
         "units": RADIANCE_UNITS,
         "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
         "extent_tan": list(extent.as_tuple()),
         "light_group": light_group,
+        **({} if mantissa_bits is None else {"mantissa_bits": mantissa_bits}),
         **(extra_attrs or {}),
     }
     arr = zarr.create_array(
         store=str(root / RADIANCE_STORE), name=f"{kind}/{unit}/{light_group}", shape=cube.shape,
         dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
+        compressors=RADIANCE_COMPRESSORS if cube.nbytes <= BLOSC_MAX_BYTES else ZARR_DEFAULT_COMPRESSORS,
         overwrite=True, config=WRITE_CONFIG,
     )
     arr[...] = cube
