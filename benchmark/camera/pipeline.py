@@ -111,11 +111,9 @@ def lens_mapping(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT):
     """What the camera's ground truth follows: (the extent its pixel grid spans, the
     lens's map from scene to sensor tangent coordinates or None for an ideal lens), as
     :func:`metricscenes.groundtruth.scale_groundtruth` takes them (``window``, ``to_sensor``)."""
-    if camera.optics.distortion is None:
-        return camera_window(camera, field), None
-    k1, k2 = camera.optics.distortion
     camera_window(camera, field)  # refused if it sees more than the field
-    return sensor_extent(camera, field), lambda xy: _distortion.distort(xy, k1, k2)
+    k = camera.optics.distortion
+    return sensor_extent(camera, field), (None if k is None else lambda xy: _distortion.distort(xy, *k))
 
 
 def electron_rate(
