@@ -79,6 +79,7 @@ def test_export_reads_back_for_isetcam(smoke_collection, tmp_path):
     np.testing.assert_allclose(box, np.array(ref_box) * 2.0)
     assert box[0] >= 0 and box[1] >= 0 and box[0] + box[2] <= 384 and box[1] + box[3] <= 216 and box[2] > 0
     assert x_tan[0] == pytest.approx(REFERENCE_EXTENT.x0 + REFERENCE_EXTENT.width / 768)
+    assert y_tan[0] == pytest.approx(REFERENCE_EXTENT.y0 + REFERENCE_EXTENT.height / 432)
 
 
 def _cli(*args):
