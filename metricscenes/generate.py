@@ -246,14 +246,21 @@ def check_before_writing(manifest: Manifest, out_dir: str | Path, workers: int =
                          scheduler: str | None = None) -> Path:
     """Everything that can refuse a run without rendering, before any output exists: the
     ``--out`` folder, the ``--scheduler``, the memory the render needs, the Mitsuba variant."""
+    return _checked_root_and_variant(manifest, out_dir, workers, scheduler)[0]
+
+
+def _checked_root_and_variant(manifest: Manifest, out_dir: str | Path, workers: int,
+                              scheduler: str | None) -> tuple[Path, str]:
+    """:func:`check_before_writing`, also returning the variant it resolved (on a running
+    cluster, resolving it is a round trip to one of its workers)."""
     from metricscenes.manifest import check_memory
 
     root = check_out_dir(out_dir)
     check_scheduler(scheduler)
     if not is_remote(scheduler):  # a running cluster's workers have their own machines' memory
         check_memory(manifest, workers, source=f"manifest {manifest.name}")
-    render_variant(manifest, scheduler)  # an LLVM variant can abort the process, CUDA needs a GPU
-    return root
+    variant = render_variant(manifest, scheduler)  # an LLVM variant can abort the process, CUDA needs a GPU
+    return root, variant
 
 
 def _has_finished_work(root: Path) -> bool:
@@ -319,8 +326,7 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
     """
     from metricscenes.lock import collection_lock
 
-    root = check_before_writing(manifest, out_dir, workers, scheduler)
-    variant = render_variant(manifest, scheduler)
+    root, variant = _checked_root_and_variant(manifest, out_dir, workers, scheduler)
     root.mkdir(parents=True, exist_ok=True)
     with collection_lock(root, notice=notice):  # one writer at a time; released on errors too
         _generate(manifest, root, variant, workers, threads, scheduler, progress, notice)
