@@ -27,13 +27,14 @@ import yaml
 
 from metricscenes import __version__
 from metricscenes.backends import check_scheduler, is_remote, map_units, threads_per_unit
+from metricscenes.files import write_atomic
 from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, coco_groundtruth, mask_box_tan
 from metricscenes.manifest import AUTO_VARIANT, PLATE_LIGHT_GROUPS, Manifest
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.store import (
     GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, read_checked,
-    resolved_content_sha256, write_atomic, write_mask, write_radiance,
+    resolved_content_sha256, write_mask, write_radiance,
 )
 
 # Margins of the inset window around the car's projected box, as fractions of the box:

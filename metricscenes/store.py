@@ -50,7 +50,6 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from metricscenes.files import write_atomic  # noqa: F401  (its home is metricscenes.files; generate imports it from here)
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.manifest import canonical_sha256, illuminance_condition, manifest_sha256, parse_illuminance_condition
