@@ -46,8 +46,8 @@ def use_variant(variant: str = "scalar_spectral", threads: int | None = None):
 _LLVM_PROBE = """
 import mitsuba as mi
 mi.set_variant({variant!r})
-scene = mi.load_dict({{"type": "scene", "sensor": {{"type": "perspective", "film": {{"type": "hdrfilm",
-    "width": 2, "height": 2}}}}, "light": {{"type": "constant"}}}})
+scene = mi.load_dict({{"type": "scene", "integrator": {{"type": "path"}}, "sensor": {{"type": "perspective",
+    "film": {{"type": "hdrfilm", "width": 2, "height": 2}}}}, "light": {{"type": "constant"}}}})
 mi.render(scene, spp=1)
 """
 

@@ -90,6 +90,19 @@ def test_llvm_variant_never_aborts_the_process(tmp_path):
         assert (tmp_path / "c" / "groundtruth.json").exists()
 
 
+def test_variant_probe_renders_with_a_variant_that_works():
+    """The probe script must itself be a valid render: with the always-working CPU variant it
+    exits 0 (it once lacked an integrator, so every LLVM and CUDA variant was refused)."""
+    import subprocess
+    import sys
+
+    from metricscenes.render import _LLVM_PROBE
+
+    probe = subprocess.run([sys.executable, "-c", _LLVM_PROBE.format(variant="scalar_spectral")],
+                           capture_output=True, text=True, timeout=300)
+    assert probe.returncode == 0, probe.stderr[-300:]
+
+
 def test_preview_exposes_the_whole_sheet_once(smoke_collection, tmp_path):
     """One white for every tile of a condition (a dark scene stays dark next to a lit one);
     --white fixes it across conditions, so night is darker than day on the same scale."""
