@@ -66,7 +66,7 @@ def test_bootstrap_reports_censoring():
 
     gt, dets = synthetic_collection(6, seed=1, half_range_m=1000.0)  # AP stays high: beyond the far end
     out = bootstrap_od50(gt, dets, n_resamples=20)
-    assert out["censored"] == ">" and out["bound_m"] == 200.0 and out["n_resamples"] == 20
+    assert out.censored == ">" and out.bound_m == 200.0 and out.n_resamples == 20
 
 
 def test_with_censoring_and_summary_table():

@@ -69,13 +69,13 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
                           for r in results["per_distance"]], columns=TABLE_COLUMNS)
     try:
         boot = run_od50(root, n_resamples=BOOTSTRAP_RESAMPLES, seed=int(results.get("seed", 0)))
+        od50_m, sd_m, (lo, hi), n_resamples = boot.od50_m, boot.sd_m, boot.ci95_m, boot.n_resamples
     except ValueError:  # one environment: no bootstrap
-        boot = {"od50_m": results.get("od50_m"), "sd_m": None, "ci95_m": [None, None]}
-    od50 = pd.DataFrame([{**ident, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
-                          "ci95_lo_m": _num(boot["ci95_m"][0]), "ci95_hi_m": _num(boot["ci95_m"][1])}])
+        od50_m, sd_m, lo, hi, n_resamples = _num(results.get("od50_m")), math.nan, math.nan, math.nan, None
+    od50 = pd.DataFrame([{**ident, "od50_m": od50_m, "sd_m": sd_m, "ci95_lo_m": lo, "ci95_hi_m": hi}])
     od50 = with_censoring(od50, table)
     meta = {"collection": results.get("collection", {}), "detector": results.get("detector", {}), "seed": results.get("seed"),
-            "n_resamples": boot.get("n_resamples")}
+            "n_resamples": n_resamples}
     return table, od50, {(cam["name"], results["condition"]): root}, meta
 
 

@@ -41,6 +41,9 @@ import numpy as np
 import pandas as pd
 
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
+from benchmark.result_files import (
+    Od50Bootstrap, Od50Cache, Od50CacheKey, ResultsFileError, read_od50_cache, write_od50_cache,
+)
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
 from metricscenes.files import write_atomic
@@ -123,29 +126,28 @@ def cached_results(run_dir: Path, key: dict) -> dict | None:
     return results
 
 
-def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
+def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     """Bootstrap OD50 of one run folder, cached in ``od50.json`` next to its detections."""
     from benchmark.scoring import bootstrap_od50
 
     run_dir = Path(run_dir)
     results = json.loads((run_dir / "results.json").read_text())
-    key = {"detections_sha256": results.get("detections_sha256"), "n_resamples": int(n_resamples), "seed": int(seed)}
+    key = Od50CacheKey(detections_sha256=results.get("detections_sha256"), n_resamples=n_resamples, seed=seed)
     cache = run_dir / "od50.json"
     try:
-        stored = json.loads(cache.read_text())
-        if stored.get("key") == key:
-            return stored["od50"]
-    except (OSError, ValueError, AttributeError):
-        pass
+        stored = read_od50_cache(cache)
+        if stored.key == key:
+            return stored.od50
+    except (OSError, ResultsFileError):
+        pass  # none yet, or unreadable: computed again
     gt = json.loads((run_dir / "groundtruth.json").read_text())
     dets = json.loads((run_dir / "detections.json").read_text())
     with warnings.catch_warnings(), np.errstate(invalid="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)  # inf - inf of resamples whose OD50 is infinite
         out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed,
                              backend=results.get("scoring_backend", "faster-coco-eval"))
-    out = {**out, "ci95_m": list(out["ci95_m"])}
-    write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
-    return _json_safe(out)
+    write_od50_cache(cache, Od50Cache(key=key, od50=out))
+    return out
 
 
 def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
@@ -275,10 +277,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                 rows.append({**ident, "condition": condition, "distance_m": r["distance_m"], "ap": r["ap"],
                              "ap50": r["ap50"], "n_images": r["n_images"]})
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
-            lo, hi = boot["ci95_m"]
-            od50_rows.append({**ident, "condition": condition, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
-                              "ci95_lo_m": _num(lo), "ci95_hi_m": _num(hi), "n_resamples": boot["n_resamples"],
-                              "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"],
+            lo, hi = boot.ci95_m
+            od50_rows.append({**ident, "condition": condition, "od50_m": boot.od50_m, "sd_m": boot.sd_m,
+                              "ci95_lo_m": lo, "ci95_hi_m": hi, "n_resamples": boot.n_resamples,
+                              "n_environments": boot.n_environments, "n_infinite": boot.n_infinite,
                               "censored": od50_censoring([r["distance_m"] for r in run_results["per_distance"]],
                                                          [r["ap"] for r in run_results["per_distance"]])[0]})
 
@@ -335,10 +337,6 @@ def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
         bounds.append(float("nan") if bound is None else bound)
     od50["censored"], od50["bound_m"] = censored, bounds
     return od50
-
-
-def _num(value) -> float:
-    return float("nan") if value is None else float(value)
 
 
 def od50_cell(row) -> str:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
+from benchmark.result_files import Od50Bootstrap, Od50CacheKey, ResultsFileError, read_od50_cache
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
@@ -111,21 +112,14 @@ def _mtf50(spec, measure: bool) -> tuple[float | None, str]:
     return (round(value, 1) if source in ("measured", "analytic") else value), source
 
 
-def _float(value) -> float:
-    """A JSON number, None (NaN) or "inf"/"-inf" (as the sweep's ``od50.json`` writes them) as a float."""
-    return float("nan") if value is None else float(value)
-
-
-def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> dict | None:
+def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> Od50Bootstrap | None:
     """The bootstrap a sweep stored in ``<run>/od50.json`` (:func:`benchmark.experiments.sweep.run_od50`), if it is for these settings."""
     try:
-        stored = json.loads((folder / "od50.json").read_text(encoding="utf-8"))
-        if stored["key"] != {"detections_sha256": detections_sha256, "n_resamples": n_resamples, "seed": seed}:
-            return None
-        boot = stored["od50"]
-        return {"sd_m": _float(boot["sd_m"]), "ci95_m": [_float(v) for v in boot["ci95_m"]]}
-    except (OSError, ValueError, KeyError, TypeError):
+        stored = read_od50_cache(folder / "od50.json")
+    except (OSError, ResultsFileError):
         return None
+    key = Od50CacheKey(detections_sha256=detections_sha256, n_resamples=n_resamples, seed=seed)
+    return stored.od50 if stored.key == key else None
 
 
 def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) -> dict:
@@ -160,9 +154,9 @@ def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) 
         with warnings.catch_warnings():  # percentiles of a distribution holding +inf OD50s warn; the CI ends become null
             warnings.simplefilter("ignore", RuntimeWarning)
             boot = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=probe["scoring"]["backend"])
-    lo, hi = (_float(v) for v in boot["ci95_m"])
+    lo, hi = boot.ci95_m
     entry.update({
-        "od50_sd_m": _none_if_not_finite(_float(boot["sd_m"])),
+        "od50_sd_m": _none_if_not_finite(boot.sd_m),
         "od50_ci95_m": [_none_if_not_finite(lo), _none_if_not_finite(hi)],
         "n_environments": len({im["environment_id"] for im in gt["images"]}),
     })  # fmt: skip
