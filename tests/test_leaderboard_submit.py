@@ -292,8 +292,8 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     assert res.exit_code == 0, res.output
     sub = json.loads(path.read_text())
     day = sub["conditions"]["day"]
-    assert day["per_distance"] == results["per_distance"]
-    assert day["od50_m"] == results["od50_m"]  # both None (inf) or the same metres
+    assert day["per_distance"] == [r.model_dump() for r in results.per_distance]
+    assert day["od50_m"] == results.od50_m  # both None (inf) or the same metres
     expected = "∞" if day["od50_m"] is None else f"{day['od50_m']:.1f}"
     row = next(line for line in (lb / "README.md").read_text().splitlines() if "cam01-yolov5n-smoke" in line)
     cells = [c.strip() for c in row.strip("|").split("|")]

@@ -9,6 +9,7 @@ import math
 from pathlib import Path
 
 import pytest
+from typer.testing import CliRunner
 
 from benchmark.result_files import (
     Od50Bootstrap,
@@ -130,6 +131,24 @@ def test_many_problems_are_counted_not_listed(tmp_path):
     (tmp_path / "results.json").write_text(json.dumps(bad))
     with pytest.raises(ResultsFileError, match=r"and 9 more\)$"):
         read_results(tmp_path / "results.json")
+
+
+@pytest.mark.parametrize("command", ["report", "compare", "submit"])
+def test_commands_refuse_a_malformed_results_json_in_one_line(tmp_path, command):
+    from benchmark.cli.main import app
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "results.json").write_text(json.dumps({**FULL, "per_distance": "all of them"}))
+    (run / "groundtruth.json").write_text('{"images": [], "annotations": []}')
+    (run / "detections.json").write_text("[]")
+    args = {"report": ["report", run], "compare": ["compare", run, run],
+            "submit": ["submit", run, "--name", "x", "--leaderboard", tmp_path / "lb"]}[command]
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    assert result.exit_code == 2, result.output
+    lines = _lines(result.output)
+    assert len(lines) == 1 and "Traceback" not in result.output, result.output
+    assert "results.json" in lines[0] and "per_distance: Input should be a valid list" in " ".join(result.output.split())
 
 
 def test_od50_cache_is_strict_json_and_reads_older_shapes(tmp_path):

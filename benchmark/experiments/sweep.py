@@ -42,7 +42,7 @@ import pandas as pd
 
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.result_files import (
-    Od50Bootstrap, Od50Cache, Od50CacheKey, ResultsFileError, read_od50_cache, write_od50_cache,
+    Od50Bootstrap, Od50Cache, Od50CacheKey, ResultsFileError, RunResults, read_od50_cache, read_results, write_od50_cache,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
@@ -99,28 +99,30 @@ def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
     return key
 
 
-def results_key(results: dict) -> dict:
-    """The cache key recorded in a ``results.json``."""
-    key = {"camera_spec_sha256": results["camera"]["spec_sha256"], "condition": results["condition"],
-           "model_sha256": results["detector"]["sha256"], "input_size": str(results["detector"]["input_size"]),
-           "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
-    if "camera_geometry" in results:
-        key["camera_geometry"] = results["camera_geometry"]
-    if "subset" in results:
-        key["subset"] = results["subset"]
-    if "class_map" in results["detector"]:
-        key["class_map"] = results["detector"]["class_map"]
+def results_key(results: RunResults) -> dict | None:
+    """The cache key recorded in a ``results.json`` (None for one that names no detector: never reused)."""
+    if results.detector is None:
+        return None
+    key = {"camera_spec_sha256": results.camera.spec_sha256, "condition": results.condition,
+           "model_sha256": results.detector.sha256, "input_size": str(results.detector.input_size),
+           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed}
+    if results.camera_geometry is not None:
+        key["camera_geometry"] = results.camera_geometry.model_dump()
+    if results.subset is not None:
+        key["subset"] = results.subset.model_dump()
+    if results.detector.class_map is not None:
+        key["class_map"] = results.detector.class_map
     return key
 
 
-def cached_results(run_dir: Path, key: dict) -> dict | None:
+def cached_results(run_dir: Path, key: dict) -> RunResults | None:
     """The results of ``run_dir`` if they are complete and carry ``key``, else None."""
     try:
-        results = json.loads((Path(run_dir) / "results.json").read_text())
-        if results_key(results) != key:
-            return None
-    except (OSError, ValueError, KeyError, TypeError):
+        results = read_results(Path(run_dir) / "results.json")
+    except (OSError, ResultsFileError):
         return None  # missing, half-written or foreign: redo
+    if results_key(results) != key:
+        return None
     if not all((Path(run_dir) / name).is_file() for name in ("detections.json", "groundtruth.json")):
         return None
     return results
@@ -131,8 +133,8 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     from benchmark.scoring import bootstrap_od50
 
     run_dir = Path(run_dir)
-    results = json.loads((run_dir / "results.json").read_text())
-    key = Od50CacheKey(detections_sha256=results.get("detections_sha256"), n_resamples=n_resamples, seed=seed)
+    results = read_results(run_dir / "results.json")
+    key = Od50CacheKey(detections_sha256=results.detections_sha256, n_resamples=n_resamples, seed=seed)
     cache = run_dir / "od50.json"
     try:
         stored = read_od50_cache(cache)
@@ -144,14 +146,13 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     dets = json.loads((run_dir / "detections.json").read_text())
     with warnings.catch_warnings(), np.errstate(invalid="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)  # inf - inf of resamples whose OD50 is infinite
-        out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed,
-                             backend=results.get("scoring_backend", "faster-coco-eval"))
+        out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=results.scoring_backend)
     write_od50_cache(cache, Od50Cache(key=key, od50=out))
     return out
 
 
 def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
-                backend: str, n_resamples: int, progress=None) -> tuple[str, str, dict]:
+                backend: str, n_resamples: int, progress=None) -> tuple[str, str, RunResults]:
     """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
     backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
     other unit touches. Returns (camera name, condition, results)."""
@@ -234,7 +235,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     total, done = n_scenes * len(cameras) * len(conditions), 0
     run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
                 for camera in cameras for condition in conditions}
-    results: dict[tuple[str, str], dict] = {}
+    results: dict[tuple[str, str], RunResults] = {}
     todo = []
     for camera in cameras:
         for condition in conditions:
@@ -273,16 +274,15 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
             runs.append({"camera": camera.name, "condition": condition, "path": str(run_dir.relative_to(out_dir)),
                          "reused": (camera.name, condition) in reused})
-            for r in run_results["per_distance"]:
-                rows.append({**ident, "condition": condition, "distance_m": r["distance_m"], "ap": r["ap"],
-                             "ap50": r["ap50"], "n_images": r["n_images"]})
+            for r in run_results.per_distance:
+                rows.append({**ident, "condition": condition, "distance_m": r.distance_m, "ap": r.ap,
+                             "ap50": r.ap50, "n_images": r.n_images})
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
             lo, hi = boot.ci95_m
             od50_rows.append({**ident, "condition": condition, "od50_m": boot.od50_m, "sd_m": boot.sd_m,
                               "ci95_lo_m": lo, "ci95_hi_m": hi, "n_resamples": boot.n_resamples,
                               "n_environments": boot.n_environments, "n_infinite": boot.n_infinite,
-                              "censored": od50_censoring([r["distance_m"] for r in run_results["per_distance"]],
-                                                         [r["ap"] for r in run_results["per_distance"]])[0]})
+                              "censored": run_results.od50_censoring()[0]})
 
     table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
     od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
