@@ -168,9 +168,13 @@ def test_od50_cache_is_strict_json_and_reads_older_shapes(tmp_path):
 
 
 def test_sweep_table_lacking_a_column_is_one_line(tmp_path):
+    from benchmark.cli.main import app
+
     sweep = tmp_path / "sw"
     sweep.mkdir()
     (sweep / "sweep.csv").write_text("camera,condition,distance_m\ncam01,day,25.0\n")
     (sweep / "od50.csv").write_text("camera,condition,od50_m\ncam01,day,80.0\n")
     with pytest.raises(ResultsFileError, match=r"sweep.csv: not a sweep.csv table \(missing column\(s\) pixel_um, "):
         read_sweep_table(sweep / "sweep.csv")
+    result = CliRunner().invoke(app, ["report", str(sweep)])
+    assert result.exit_code == 2 and len(_lines(result.output)) == 1 and "missing column(s)" in result.output

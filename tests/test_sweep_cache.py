@@ -228,6 +228,8 @@ def test_mtf_sources_and_errors(tmp_path, monkeypatch):
 
 
 def test_json_is_strict(tmp_path, monkeypatch):
-    assert sweep_module._json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
+    from benchmark.result_files import json_safe
+
+    assert json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
     make_fake_sweep(tmp_path / "sw", monkeypatch)
     json.loads((tmp_path / "sw" / "sweep.json").read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))

@@ -31,7 +31,7 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
-from benchmark.result_files import ResultsFileError, RunResults, read_results
+from benchmark.result_files import ResultsFileError, RunResults, read_results, read_sweep_record
 from benchmark.scoring import ap_by_distance, format_od50, od50, od50_censoring
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
 
@@ -85,10 +85,9 @@ def resolve_run(path: str | Path, camera: str | None = None, condition: str = "d
         raise CompareError(f"{path} is not a run folder (no results.json); for a sweep folder name the camera with --camera")
     meta_path = path / "sweep.json"
     if meta_path.is_file():
-        meta = json.loads(meta_path.read_text())
-        for run in meta.get("runs", []):
-            if run.get("camera") == camera and run.get("condition") == condition:
-                return path / run["path"]
+        for run in read_sweep_record(meta_path).runs:
+            if run.camera == camera and run.condition == condition:
+                return path / run.path
     candidate = path / "runs" / f"{camera}-{condition}"
     if (candidate / "results.json").is_file():
         return candidate

@@ -29,9 +29,8 @@ import pandas as pd  # noqa: E402
 
 from benchmark.experiments import spm  # noqa: E402
 from benchmark.measure.mtf import camera_mtf50  # noqa: E402
-from benchmark.result_files import CameraRecord, read_results  # noqa: E402
+from benchmark.result_files import TABLE_COLUMNS, CameraRecord, read_results, read_sweep_record  # noqa: E402
 from benchmark.experiments.sweep import (  # noqa: E402
-    TABLE_COLUMNS,
     illuminance_table,
     load_sweep,
     run_name,
@@ -53,9 +52,12 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
     root = Path(results_dir)
     if (root / "sweep.csv").is_file():
         table, od50 = load_sweep(root)
-        meta = json.loads((root / "sweep.json").read_text()) if (root / "sweep.json").is_file() else {}
-        # sweep.json names each run's folder (tagged when an exposure policy overrode the cameras')
-        paths = {(r["camera"], r["condition"]): root / r["path"] for r in meta.get("runs", []) if "path" in r}
+        meta, paths = {}, {}
+        if (root / "sweep.json").is_file():
+            record = read_sweep_record(root / "sweep.json")
+            meta = record.model_dump(exclude_unset=True)  # the page's facts
+            # sweep.json names each run's folder (tagged when an exposure policy overrode the cameras')
+            paths = {(r.camera, r.condition): root / r.path for r in record.runs}
         runs = {(c, k): paths.get((c, k), root / "runs" / run_name(c, k))
                 for c, k in od50[["camera", "condition"]].itertuples(index=False)}
         return table, od50, runs, meta

@@ -14,13 +14,15 @@ only its missing (or stale) runs. Those runs may go to worker processes or a das
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
 do not depend on where the runs ran.
 
-Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
+Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7), their schemas in :mod:`benchmark.result_files`:
 
 - ``sweep.csv`` / ``sweep.json``: one row per camera × condition × distance with
   ``camera, pixel_um, f_number, mtf50_cy_per_mm, mtf50_source, condition, distance_m,
-  ap, ap50, n_images``;
+  ap, ap50, n_images`` (:class:`~benchmark.result_files.SweepRow`; sweep.json:
+  :class:`~benchmark.result_files.SweepRecord`);
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
-  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`).
+  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`;
+  :class:`~benchmark.result_files.Od50Row`).
 
 MTF50 comes from :func:`benchmark.measure.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
 (ISO 12233 slanted edge through the camera), ``analytic`` (diffraction × pixel aperture)
@@ -30,7 +32,6 @@ or ``published_group`` (the paper's MTF50 group of a registry camera).
 from __future__ import annotations
 
 import json
-import math
 import os
 import warnings
 from contextlib import closing
@@ -41,23 +42,21 @@ import numpy as np
 import pandas as pd
 
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
+from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
 from benchmark.result_files import (
-    Od50Bootstrap, Od50Cache, Od50CacheKey, ResultsFileError, RunResults, read_od50_cache, read_results, write_od50_cache,
+    SWEEP_FORMAT, CollectionRecord, DetectorRecord, Od50Bootstrap, Od50Cache, Od50CacheKey,
+    Od50Row, ResultsFileError, RunResults, Subset, SweepExposure, SweepRecord, SweepRow, SweepRun,
+    read_od50_cache, read_od50_table, read_results, read_sweep_table, write_od50_cache, write_od50_table,
+    write_sweep_record, write_sweep_table,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
-from metricscenes.files import write_atomic
 from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
     from benchmark.camera.spec import ExposureSpec
 
-SWEEP_FORMAT = "metricscenes-sweep/1"
-TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
-                 "distance_m", "ap", "ap50", "n_images"]
-OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
-                "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite", "censored"]
-# censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
+# od50.csv's censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
 # extrapolation, report "> farthest m") or "<" (below 0.5 already at the nearest); see benchmark.scoring.od50
 
 
@@ -267,42 +266,39 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     rows, od50_rows, runs = [], [], []
     for camera in cameras:
         mtf50, source = camera_mtf50(camera, mtf_source)
-        mtf50 = float("nan") if mtf50 is None else mtf50  # a table cell
         ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
-                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
+                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}  # mtf50 None: NaN in the tables
         for condition in conditions:
             run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
-            runs.append({"camera": camera.name, "condition": condition, "path": str(run_dir.relative_to(out_dir)),
-                         "reused": (camera.name, condition) in reused})
+            runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
+                                 reused=(camera.name, condition) in reused))
             for r in run_results.per_distance:
-                rows.append({**ident, "condition": condition, "distance_m": r.distance_m, "ap": r.ap,
-                             "ap50": r.ap50, "n_images": r.n_images})
+                rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
+                                     n_images=r.n_images))
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
             lo, hi = boot.ci95_m
-            od50_rows.append({**ident, "condition": condition, "od50_m": boot.od50_m, "sd_m": boot.sd_m,
-                              "ci95_lo_m": lo, "ci95_hi_m": hi, "n_resamples": boot.n_resamples,
-                              "n_environments": boot.n_environments, "n_infinite": boot.n_infinite,
-                              "censored": run_results.od50_censoring()[0]})
+            od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
+                                     ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
+                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
 
-    table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
-    od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
-    write_atomic(out_dir / "sweep.csv", table.to_csv(index=False))
-    write_atomic(out_dir / "od50.csv", od50_table.to_csv(index=False))
-    meta = {
-        "format": SWEEP_FORMAT,
-        "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
-        "detector": {"name": detector.name, "sha256": detector.sha256, "input_size": str(detector.input_size)},
-        "seed": int(seed), "n_resamples": int(n_resamples), "mtf_source": mtf_source, "scoring_backend": backend,
-        "cameras": names, "conditions": conditions, "runs": runs,
-        "table": _json_safe(table.to_dict(orient="records")),
-        "od50": _json_safe(od50_table.to_dict(orient="records")),
-    }
+    table = write_sweep_table(out_dir / "sweep.csv", rows)
+    od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
+    record = SweepRecord(
+        format=SWEEP_FORMAT,
+        collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
+                                    path=str(collection.root)),
+        detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
+        seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
+        cameras=names, conditions=conditions, runs=runs,
+        # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
+        table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
+    )
     if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
-        meta["subset"] = subset
+        record.subset = Subset(**subset)
     if exposure is not None:  # only then, so that other sweeps keep their bytes
-        meta["exposure"] = {"policy": format_exposure(exposure), "tag": exposure_tag(exposure),
-                            "spec": exposure.model_dump(mode="json")}
-    write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
+        record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
+                                        spec=exposure.model_dump(mode="json"))
+    write_sweep_record(out_dir / "sweep.json", record)
     return table
 
 
@@ -317,10 +313,10 @@ def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def load_sweep(out_dir) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(AP table, OD50 table) of a sweep folder."""
+    """(AP table, OD50 table) of a sweep folder (``sweep.csv``, ``od50.csv``)."""
     out_dir = Path(out_dir)
-    table = pd.read_csv(out_dir / "sweep.csv")
-    return table, with_censoring(pd.read_csv(out_dir / "od50.csv"), table)
+    table = read_sweep_table(out_dir / "sweep.csv")
+    return table, with_censoring(read_od50_table(out_dir / "od50.csv"), table)
 
 
 def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
@@ -347,18 +343,3 @@ def od50_cell(row) -> str:
     bound = row.get("bound_m")
     bound = None if bound is None or bound != bound else float(bound)
     return format_od50(row["od50_m"], censored, bound, row.get("sd_m"), unit="")
-
-
-def _json_safe(value):
-    """Strict JSON: NaN becomes None, ±inf the strings "inf"/"-inf" (``float()`` reads them back)."""
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        if math.isnan(value):
-            return None
-        return float(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
