@@ -21,13 +21,15 @@ and what is reported is a bound, "> 200 m" or "< 25 m" (:mod:`benchmark.scoring.
 docs/detection.md). The records keep the number; :meth:`RunResults.od50_censoring`,
 ``Od50Bootstrap.censored`` and ``Od50Row.censored`` say whether it is a bound.
 
-Bytes. The writers write what the code before them wrote, byte for byte: the fields a writer
-set, in the order the model declares them (optional fields it left out stay out of the file),
-Python's float repr, ``indent=1`` for JSON. Strict JSON (``od50.json``, ``sweep.json``) holds
-NaN as null and ±inf as "inf"/"-inf" (:func:`json_safe`); ``results.json`` holds its floats
-as ``json.dumps`` writes them. Every model keeps keys it does not know (``extra="allow"``):
-a file from a newer writer reads, and fields that older files or hand-made test runs lack
-are optional, with the default their readers always used.
+Bytes. A file holds the fields its writer set, in the order the model declares them (an
+optional field left unset stays out of the file), floats as Python's repr, JSON with
+``indent=1``: the bytes the dict-based writers wrote before these records, so older results
+still hash, cache and compare the same (tests/test_result_files.py reads and rewrites them).
+Strict JSON (``od50.json``, ``sweep.json``) holds NaN as null and ±inf as "inf"/"-inf"
+(:func:`json_safe`); ``results.json`` holds its floats as ``json.dumps`` writes them (a NaN
+AP as ``NaN``). Every model keeps keys it does not know (``extra="allow"``), and the fields
+that older files or hand-made runs lack are optional, with the default their readers
+always assumed.
 """
 
 from __future__ import annotations
