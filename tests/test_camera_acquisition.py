@@ -370,9 +370,9 @@ def test_run_records_the_hdr_short_exposures(tmp_path):
 
     cam = with_exposure(load_camera("cam01"), parse_exposure("hdr:16"))
     results = run_camera(Collection(tmp_path), cam, "day", Detector(), tmp_path / "run", save_images=False)
-    assert results["camera"]["spec"]["exposure"]["mode"] == "hdr"
-    assert set(results["exposure_short_s"]) == set(results["exposure_s"]) and len(results["exposure_s"]) == 2
-    for scene_id, long_s in results["exposure_s"].items():
-        assert long_s == pytest.approx(16 * results["exposure_short_s"][scene_id])
+    assert results.camera.spec["exposure"]["mode"] == "hdr"
+    assert set(results.exposure_short_s) == set(results.exposure_s) and len(results.exposure_s) == 2
+    for scene_id, long_s in results.exposure_s.items():
+        assert long_s == pytest.approx(16 * results.exposure_short_s[scene_id])
     plain = run_camera(Collection(tmp_path), load_camera("cam01"), "day", Detector(), tmp_path / "plain", save_images=False)
-    assert "exposure_short_s" not in plain
+    assert plain.exposure_short_s is None and "exposure_short_s" not in (tmp_path / "plain" / "results.json").read_text()

@@ -17,8 +17,10 @@ SHA = "f" * 64
 def side(gt, dets, name="camA", condition="day", sha=SHA, folder="run") -> Side:
     from pathlib import Path
 
-    results = {"camera": {"name": name}, "condition": condition, "collection": {"manifest_sha256": sha},
-               "scoring_backend": "faster-coco-eval"}
+    from benchmark.result_files import RunResults
+
+    results = RunResults.model_validate({"camera": {"name": name}, "condition": condition,
+                                         "collection": {"manifest_sha256": sha}, "scoring_backend": "faster-coco-eval"})
     return Side(Path(folder), results, gt, dets)
 
 

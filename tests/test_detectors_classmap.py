@@ -61,6 +61,7 @@ def test_custom_classes_dropped_and_merged(tmp_path):
 def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
     from benchmark.camera import load_camera
     from benchmark.experiments.sweep import results_key, run_key
+    from benchmark.result_files import RunResults
     from test_sweep_cache import FakeCollection, FakeDetector
 
     class Mapped(FakeDetector):
@@ -69,10 +70,10 @@ def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
     col, cam = FakeCollection(tmp_path), load_camera("cam01")
     plain, mapped = run_key(cam, "day", FakeDetector(), col, 0), run_key(cam, "day", Mapped(), col, 0)
     assert "class_map" not in plain and mapped["class_map"] == ["car"]
-    results = {"camera": {"spec_sha256": cam.sha256()}, "condition": "day",
-               "detector": {"sha256": "d" * 64, "input_size": "multiscale", "class_map": ["car"]},
+    results = {"camera": {"name": "cam01", "spec_sha256": cam.sha256()}, "condition": "day",
+               "detector": {"name": "fake", "sha256": "d" * 64, "input_size": "multiscale", "class_map": ["car"]},
                "collection": {"manifest_sha256": "f" * 64}, "seed": 0}
-    assert results_key(results) == mapped != plain
+    assert results_key(RunResults.model_validate(results)) == mapped != plain
 
 
 def test_cli_class_map_errors_are_one_line(tmp_path):
@@ -119,4 +120,4 @@ def test_run_camera_writes_the_class_map(tmp_path, monkeypatch):
 
     monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
     results = run_camera(Collection(tmp_path), load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
-    assert results["detector"]["class_map"] == ["car"]
+    assert results.detector.class_map == ["car"]

@@ -110,7 +110,7 @@ def test_submit_a_run_folder(app, sweep, leaderboard, monkeypatch):
     curve = od50([r["distance_m"] for r in day["per_distance"]], [r["ap"] for r in day["per_distance"]])
     assert day["od50_m"] == pytest.approx(curve, abs=5e-4) and 50 < curve < 200
     boot = bootstrap_od50(gt, dets, n_resamples=30, seed=0)  # the SD is the scorer's bootstrap, same settings
-    assert day["od50_sd_m"] == pytest.approx(boot["sd_m"], abs=5e-4) and day["od50_sd_m"] > 0
+    assert day["od50_sd_m"] == pytest.approx(boot.sd_m, abs=5e-4) and day["od50_sd_m"] > 0
     assert day["n_environments"] == 4
     assert sub["detector"]["licence"] == "AGPL-3.0" and sub["camera"]["mtf50_source"] == "measured"
     from benchmark.camera import load_camera
@@ -292,8 +292,8 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     assert res.exit_code == 0, res.output
     sub = json.loads(path.read_text())
     day = sub["conditions"]["day"]
-    assert day["per_distance"] == results["per_distance"]
-    assert day["od50_m"] == results["od50_m"]  # both None (inf) or the same metres
+    assert day["per_distance"] == [r.model_dump() for r in results.per_distance]
+    assert day["od50_m"] == results.od50_m  # both None (inf) or the same metres
     expected = "∞" if day["od50_m"] is None else f"{day['od50_m']:.1f}"
     row = next(line for line in (lb / "README.md").read_text().splitlines() if "cam01-yolov5n-smoke" in line)
     cells = [c.strip() for c in row.strip("|").split("|")]

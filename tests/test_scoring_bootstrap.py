@@ -32,17 +32,17 @@ def test_same_seed_same_result_and_other_seed_differs():
     b = bootstrap_od50(gt, dets, n_resamples=200, seed=7)
     c = bootstrap_od50(gt, dets, n_resamples=200, seed=8)
     assert a == b
-    assert a["sd_m"] != c["sd_m"]
-    assert a["n_resamples"] == 200 and a["n_environments"] == 10
-    lo, hi = a["ci95_m"]
-    assert lo < a["od50_m"] < hi
-    assert 0 < a["sd_m"] < hi - lo
+    assert a.sd_m != c.sd_m
+    assert a.n_resamples == 200 and a.n_environments == 10
+    lo, hi = a.ci95_m
+    assert lo < a.od50_m < hi
+    assert 0 < a.sd_m < hi - lo
 
 
 def test_sd_shrinks_with_more_environments():
     # SD of a mean-like statistic scales ~ 1/sqrt(n): 4x the environments ~ half the SD
-    small = [bootstrap_od50(*synthetic_collection(10, seed=s), n_resamples=200, seed=0)["sd_m"] for s in range(3)]
-    large = [bootstrap_od50(*synthetic_collection(40, seed=s), n_resamples=200, seed=0)["sd_m"] for s in range(3)]
+    small = [bootstrap_od50(*synthetic_collection(10, seed=s), n_resamples=200, seed=0).sd_m for s in range(3)]
+    large = [bootstrap_od50(*synthetic_collection(40, seed=s), n_resamples=200, seed=0).sd_m for s in range(3)]
     assert np.mean(large) < 0.75 * np.mean(small)
 
 
@@ -52,7 +52,7 @@ def test_point_estimate_is_od50_of_full_set_and_errors():
     from benchmark.scoring import od50
 
     rows = ap_by_distance(gt, dets)
-    assert res["od50_m"] == pytest.approx(od50([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
+    assert res.od50_m == pytest.approx(od50([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
     with pytest.raises(ValueError, match="n_resamples"):
         bootstrap_od50(gt, dets, n_resamples=1)
     one_env = {**gt, "images": [im for im in gt["images"] if im["environment_id"] == 0]}
@@ -63,7 +63,7 @@ def test_point_estimate_is_od50_of_full_set_and_errors():
 def test_no_detections_bootstrap():
     gt, _ = synthetic_collection(4, seed=0)
     res = bootstrap_od50(gt, [], n_resamples=20)
-    assert res["od50_m"] == 0.0 and res["sd_m"] == 0.0
+    assert res.od50_m == 0.0 and res.sd_m == 0.0
 
 
 def test_percentile_interval_with_unreachable_od50():

@@ -66,7 +66,7 @@ def test_bootstrap_reports_censoring():
 
     gt, dets = synthetic_collection(6, seed=1, half_range_m=1000.0)  # AP stays high: beyond the far end
     out = bootstrap_od50(gt, dets, n_resamples=20)
-    assert out["censored"] == ">" and out["bound_m"] == 200.0 and out["n_resamples"] == 20
+    assert out.censored == ">" and out.bound_m == 200.0 and out.n_resamples == 20
 
 
 def test_with_censoring_and_summary_table():
@@ -154,7 +154,7 @@ def test_committed_leaderboard_shows_no_extrapolated_number():
 def test_run_and_score_print_a_bound_not_an_extrapolation():
     from benchmark.cli.main import od50_text
 
-    rows = lambda aps: [{"distance_m": d, "ap": a} for d, a in zip((25.0, 50.0, 100.0, 200.0), aps)]  # noqa: E731
-    assert od50_text(rows((0.9, 0.85, 0.8, 0.7))) == "OD50 > 200 m"  # extrapolation would say ~480 m
-    assert od50_text(rows((0.4, 0.3, 0.2, 0.1))) == "OD50 < 25 m"
-    assert od50_text(rows((0.9, 0.7, 0.3, 0.1))) == "OD50 75.0 m"
+    distances = (25.0, 50.0, 100.0, 200.0)
+    assert od50_text(distances, (0.9, 0.85, 0.8, 0.7)) == "OD50 > 200 m"  # extrapolation would say ~480 m
+    assert od50_text(distances, (0.4, 0.3, 0.2, 0.1)) == "OD50 < 25 m"
+    assert od50_text(distances, (0.9, 0.7, 0.3, 0.1)) == "OD50 75.0 m"

@@ -64,13 +64,13 @@ def test_run_camera_records_the_subset(tmp_path, monkeypatch):
     col = Collection(tmp_path)
     view = subset_collection(col, "1", None)
     results = run_camera(view, load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
-    assert results["subset"]["environments"] == [1]
-    assert set(results["exposure_s"]) == {s.scene_id for s in col.scenes() if s.environment_id == 1}
+    assert results.subset.environments == [1]
+    assert set(results.exposure_s) == {s.scene_id for s in col.scenes() if s.environment_id == 1}
     gt = json.loads((tmp_path / "run" / "groundtruth.json").read_text())
     assert {im["environment_id"] for im in gt["images"]} == {1}
-    assert json.loads((tmp_path / "run" / "results.json").read_text())["subset"] == results["subset"]
+    assert json.loads((tmp_path / "run" / "results.json").read_text())["subset"] == results.subset.model_dump()
     full = run_camera(col, load_camera("cam01"), "day", Detector(), tmp_path / "full", save_images=False)
-    assert "subset" not in full  # full runs keep their bytes
+    assert full.subset is None and "subset" not in (tmp_path / "full" / "results.json").read_text()  # full runs keep their bytes
 
 
 @pytest.fixture
@@ -79,10 +79,12 @@ def fakes(monkeypatch, tmp_path):
     import metricscenes.store
 
     def run(collection, *args, **kwargs):  # the fake writes what run_camera writes, with its subset mark
+        from benchmark.result_files import Subset, write_results
+
         results = fake_run_camera(collection, *args, **kwargs)
         if getattr(collection, "subset", None):
-            results["subset"] = collection.subset
-            (args[3] / "results.json").write_text(json.dumps(results))
+            results.subset = Subset(**collection.subset)
+            write_results(args[3] / "results.json", results)
         return results
 
     monkeypatch.setattr("benchmark.experiments.run.run_camera", run)
@@ -114,6 +116,7 @@ def test_subset_sweep_is_marked_and_never_reused_as_full(fakes):
 
 def test_subset_cache_key(tmp_path):
     from benchmark.experiments.sweep import results_key, run_key
+    from benchmark.result_files import RunResults
 
     col = FakeCollection(tmp_path)
     cam = load_camera("cam01")
@@ -121,9 +124,10 @@ def test_subset_cache_key(tmp_path):
     sub_key = run_key(cam, "day", FakeDetector(), subset_collection(col, "0", None), 0)
     assert "subset" not in full_key and sub_key["subset"] == {"environments": [0],
                                                               "distances_m": sorted({s.distance_m for s in col.scenes()})}
-    results = {"camera": {"spec_sha256": cam.sha256()}, "condition": "day", "detector": {"sha256": "d" * 64, "input_size": "multiscale"},
+    results = {"camera": {"name": "cam01", "spec_sha256": cam.sha256()}, "condition": "day",
+               "detector": {"name": "fake", "sha256": "d" * 64, "input_size": "multiscale"},
                "collection": {"manifest_sha256": "f" * 64}, "seed": 0, "subset": sub_key["subset"]}
-    assert results_key(results) == sub_key != full_key
+    assert results_key(RunResults.model_validate(results)) == sub_key != full_key
 
 
 @pytest.mark.parametrize("command", ["run", "sweep"])
@@ -143,7 +147,9 @@ def test_submit_refuses_a_subset_run(tmp_path):
     from benchmark.leaderboard.schema import SubmissionError
     from benchmark.leaderboard.submission import RESULTS_FORMAT, find_runs
 
-    (tmp_path / "results.json").write_text(json.dumps({"format": RESULTS_FORMAT, "subset": {"environments": [0]}}))
+    subset = {"environments": [0], "distances_m": [25.0, 50.0]}
+    (tmp_path / "results.json").write_text(json.dumps({"format": RESULTS_FORMAT, "camera": {"name": "cam01"}, "condition": "day",
+                                                       "collection": {"manifest_sha256": "f" * 64}, "subset": subset}))
     with pytest.raises(SubmissionError, match="a subset run"):
         find_runs(tmp_path)
     result = CliRunner().invoke(app, ["submit", str(tmp_path), "--name", "quick"])

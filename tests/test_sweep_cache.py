@@ -80,6 +80,7 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
     from PIL import Image, ImageDraw
 
     from benchmark.experiments.run import sha256_bytes
+    from benchmark.result_files import RunResults, write_results
     from metricscenes.groundtruth import scale_groundtruth
 
     out_dir = Path(out_dir)
@@ -100,7 +101,7 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
             progress(i + 1, len(scenes))
     per_distance = ap_by_distance(gt, dets, backend=backend)
     data = json.dumps(dets).encode()
-    results = {
+    results = RunResults.model_validate({
         "camera": {"name": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
                    "width_px": camera.width_px, "height_px": camera.height_px, "spec_sha256": camera.sha256()},
         "condition": condition,
@@ -108,10 +109,10 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
         "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
         "seed": seed, "scoring_backend": backend, "per_distance": per_distance, "od50_m": None,
         "detections_sha256": sha256_bytes(data),
-    }
+    })
     (out_dir / "detections.json").write_bytes(data)
     (out_dir / "groundtruth.json").write_text(json.dumps(gt))
-    (out_dir / "results.json").write_text(json.dumps(results))
+    write_results(out_dir / "results.json", results)
     return results
 
 
@@ -170,9 +171,9 @@ def test_od50_table_matches_bootstrap(tmp_path, monkeypatch):
     oracle = bootstrap_od50(json.loads((run / "groundtruth.json").read_text()),
                             json.loads((run / "detections.json").read_text()), n_resamples=40, seed=3)
     row = od[(od.camera == "cam01") & (od.condition == "day")].iloc[0]
-    assert row.od50_m == pytest.approx(oracle["od50_m"])
-    assert row.sd_m == pytest.approx(oracle["sd_m"])
-    assert (row.ci95_lo_m, row.ci95_hi_m) == pytest.approx(oracle["ci95_m"])
+    assert row.od50_m == pytest.approx(oracle.od50_m)
+    assert row.sd_m == pytest.approx(oracle.sd_m)
+    assert (row.ci95_lo_m, row.ci95_hi_m) == pytest.approx(oracle.ci95_m)
     assert row.n_resamples == 40 and row.n_environments == N_ENV
 
 
@@ -227,6 +228,8 @@ def test_mtf_sources_and_errors(tmp_path, monkeypatch):
 
 
 def test_json_is_strict(tmp_path, monkeypatch):
-    assert sweep_module._json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
+    from benchmark.result_files import json_safe
+
+    assert json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
     make_fake_sweep(tmp_path / "sw", monkeypatch)
     json.loads((tmp_path / "sw" / "sweep.json").read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))

@@ -89,12 +89,12 @@ def run(
     table = Table(title=title)
     for col_name in ("distance (m)", "AP", "AP50", "images"):
         table.add_column(col_name, justify="right")
-    for row in results["per_distance"]:
-        table.add_row(f"{row['distance_m']:g}", f"{row['ap']:.3f}", f"{row['ap50']:.3f}", str(row["n_images"]))
+    for row in results.per_distance:
+        table.add_row(f"{row.distance_m:g}", f"{row.ap:.3f}", f"{row.ap50:.3f}", str(row.n_images))
     console.print(table)
-    console.print(od50_text(results["per_distance"]))
-    if results.get("subset"):
-        console.print(subset_text(results["subset"]))
+    console.print(od50_text(*results.ap_curve()))
+    if results.subset:
+        console.print(subset_text(results.subset.model_dump()))
     console.print(f"wrote {out / 'results.json'}")
 
 
@@ -236,17 +236,16 @@ def score(
         table.add_row(f"{r['distance_m']:g}", f"{r['ap']:.3f}", f"{r['ap50']:.3f}",
                       f"{r['detected']}/{r['n_images']}", taken)
     console.print(table)
-    console.print(od50_text(rows))
+    console.print(od50_text([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
 
 
-def od50_text(per_distance: list[dict]) -> str:
+def od50_text(distances_m: list[float], ap: list[float]) -> str:
     """OD50 for people, read off the AP curve: a bound where AP does not cross 0.5 inside the
     measured distances ("OD50 > 200 m", "OD50 < 25 m"), never an extrapolated number."""
     from benchmark.scoring.od50 import format_od50, od50, od50_censoring
 
-    distances, ap = [r["distance_m"] for r in per_distance], [r["ap"] for r in per_distance]
-    censored, bound_m = od50_censoring(distances, ap)
-    return "OD50 " + format_od50(od50(distances, ap), censored, bound_m)
+    censored, bound_m = od50_censoring(distances_m, ap)
+    return "OD50 " + format_od50(od50(distances_m, ap), censored, bound_m)
 
 
 def main() -> None:

@@ -31,6 +31,7 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
+from benchmark.result_files import ResultsFileError, RunResults, read_results, read_sweep_record
 from benchmark.scoring import ap_by_distance, format_od50, od50, od50_censoring
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
 
@@ -47,21 +48,21 @@ class Side:
     """One side of a comparison: a run folder's results, ground truth and detections."""
 
     folder: Path
-    results: dict
+    results: RunResults
     groundtruth: dict
     detections: list
 
     @property
     def camera(self) -> str:
-        return str(self.results.get("camera", {}).get("name", self.folder.name))
+        return self.results.camera.name
 
     @property
     def condition(self) -> str:
-        return str(self.results.get("condition", ""))
+        return self.results.condition
 
     @property
-    def manifest_sha256(self) -> str | None:
-        return self.results.get("collection", {}).get("manifest_sha256")
+    def manifest_sha256(self) -> str:
+        return self.results.collection.manifest_sha256
 
     @property
     def environments(self) -> set:
@@ -84,10 +85,9 @@ def resolve_run(path: str | Path, camera: str | None = None, condition: str = "d
         raise CompareError(f"{path} is not a run folder (no results.json); for a sweep folder name the camera with --camera")
     meta_path = path / "sweep.json"
     if meta_path.is_file():
-        meta = json.loads(meta_path.read_text())
-        for run in meta.get("runs", []):
-            if run.get("camera") == camera and run.get("condition") == condition:
-                return path / run["path"]
+        for run in read_sweep_record(meta_path).runs:
+            if run.camera == camera and run.condition == condition:
+                return path / run.path
     candidate = path / "runs" / f"{camera}-{condition}"
     if (candidate / "results.json").is_file():
         return candidate
@@ -97,11 +97,13 @@ def resolve_run(path: str | Path, camera: str | None = None, condition: str = "d
 def load_side(folder: str | Path) -> Side:
     folder = Path(folder)
     try:
-        return Side(folder, json.loads((folder / "results.json").read_text()),
+        return Side(folder, read_results(folder / "results.json"),
                     json.loads((folder / "groundtruth.json").read_text()),
                     json.loads((folder / "detections.json").read_text()))
     except FileNotFoundError as exc:
         raise CompareError(f"{folder}: not a run folder ({Path(exc.filename).name} is missing)") from None
+    except ResultsFileError as exc:  # already one line naming the file
+        raise CompareError(str(exc)) from None
     except json.JSONDecodeError as exc:
         raise CompareError(f"{folder}: unreadable JSON ({exc})") from None
 
@@ -149,7 +151,7 @@ def compare_runs(
     if len(envs) < 2:
         raise CompareError(f"cannot compare: a bootstrap needs two or more environments, got {len(envs)}")
     env_index = {e: k for k, e in enumerate(envs)}
-    backend = a.results.get("scoring_backend", "faster-coco-eval")
+    backend = a.results.scoring_backend
     sides = {}
     for key, side in (("a", a), ("b", b)):
         rows = ap_by_distance(side.groundtruth, side.detections, backend=backend, category_id=category_id)

@@ -29,8 +29,8 @@ import pandas as pd  # noqa: E402
 
 from benchmark.experiments import spm  # noqa: E402
 from benchmark.measure.mtf import camera_mtf50  # noqa: E402
+from benchmark.result_files import TABLE_COLUMNS, CameraRecord, read_results, read_sweep_record  # noqa: E402
 from benchmark.experiments.sweep import (  # noqa: E402
-    TABLE_COLUMNS,
     illuminance_table,
     load_sweep,
     run_name,
@@ -52,31 +52,35 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
     root = Path(results_dir)
     if (root / "sweep.csv").is_file():
         table, od50 = load_sweep(root)
-        meta = json.loads((root / "sweep.json").read_text()) if (root / "sweep.json").is_file() else {}
-        # sweep.json names each run's folder (tagged when an exposure policy overrode the cameras')
-        paths = {(r["camera"], r["condition"]): root / r["path"] for r in meta.get("runs", []) if "path" in r}
+        meta, paths = {}, {}
+        if (root / "sweep.json").is_file():
+            record = read_sweep_record(root / "sweep.json")
+            meta = record.model_dump(exclude_unset=True)  # the page's facts
+            # sweep.json names each run's folder (tagged when an exposure policy overrode the cameras')
+            paths = {(r.camera, r.condition): root / r.path for r in record.runs}
         runs = {(c, k): paths.get((c, k), root / "runs" / run_name(c, k))
                 for c, k in od50[["camera", "condition"]].itertuples(index=False)}
         return table, od50, runs, meta
     if not (root / "results.json").is_file():
         raise ValueError(f"{root} is neither a sweep folder (sweep.csv) nor a run folder (results.json)")
-    results = json.loads((root / "results.json").read_text())
-    cam = results["camera"]
+    results = read_results(root / "results.json")
+    cam = results.camera
     mtf50, source = _run_mtf50(cam)
-    ident = {"camera": cam["name"], "pixel_um": cam["pixel_um"], "f_number": cam["f_number"],
-             "mtf50_cy_per_mm": mtf50, "mtf50_source": source, "condition": results["condition"]}
-    table = pd.DataFrame([{**ident, **{k: r[k] for k in ("distance_m", "ap", "ap50", "n_images")}}
-                          for r in results["per_distance"]], columns=TABLE_COLUMNS)
+    ident = {"camera": cam.name, "pixel_um": cam.pixel_um, "f_number": cam.f_number,
+             "mtf50_cy_per_mm": mtf50, "mtf50_source": source, "condition": results.condition}
+    table = pd.DataFrame([{**ident, "distance_m": r.distance_m, "ap": r.ap, "ap50": r.ap50, "n_images": r.n_images}
+                          for r in results.per_distance], columns=TABLE_COLUMNS)
     try:
-        boot = run_od50(root, n_resamples=BOOTSTRAP_RESAMPLES, seed=int(results.get("seed", 0)))
+        boot = run_od50(root, n_resamples=BOOTSTRAP_RESAMPLES, seed=results.seed)
+        od50_m, sd_m, (lo, hi), n_resamples = boot.od50_m, boot.sd_m, boot.ci95_m, boot.n_resamples
     except ValueError:  # one environment: no bootstrap
-        boot = {"od50_m": results.get("od50_m"), "sd_m": None, "ci95_m": [None, None]}
-    od50 = pd.DataFrame([{**ident, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
-                          "ci95_lo_m": _num(boot["ci95_m"][0]), "ci95_hi_m": _num(boot["ci95_m"][1])}])
+        od50_m, sd_m, lo, hi, n_resamples = _num(results.od50_m), math.nan, math.nan, math.nan, None
+    od50 = pd.DataFrame([{**ident, "od50_m": od50_m, "sd_m": sd_m, "ci95_lo_m": lo, "ci95_hi_m": hi}])
     od50 = with_censoring(od50, table)
-    meta = {"collection": results.get("collection", {}), "detector": results.get("detector", {}), "seed": results.get("seed"),
-            "n_resamples": boot.get("n_resamples")}
-    return table, od50, {(cam["name"], results["condition"]): root}, meta
+    meta = {"collection": results.collection.model_dump(exclude_unset=True),
+            "detector": results.detector.model_dump(exclude_unset=True) if results.detector else {},
+            "seed": results.seed, "n_resamples": n_resamples}
+    return table, od50, {(cam.name, results.condition): root}, meta
 
 
 def plot_ap_curves(table: pd.DataFrame, out=None):
@@ -263,12 +267,12 @@ def _page(meta: dict, body: str) -> str:
             f"<style>{style}</style></head><body><h1>metricscenes benchmark report</h1><ul>{items}</ul>\n{body}\n</body></html>\n")
 
 
-def _run_mtf50(cam: dict) -> tuple[float, str]:
+def _run_mtf50(cam: CameraRecord) -> tuple[float, str]:
     """MTF50 of a run's camera from the spec recorded in its results.json (NaN, "none":
     no spec, or no source gave one)."""
     from benchmark.camera import camera_from_dict
 
-    spec = json.loads(json.dumps(cam.get("spec") or {}))
+    spec = json.loads(json.dumps(cam.spec or {}))
     spec.get("sensor", {}).pop("width_px", None), spec.get("sensor", {}).pop("height_px", None)  # computed fields
     try:
         value, source = camera_mtf50(camera_from_dict(spec))

@@ -4,7 +4,8 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
 → :func:`benchmark.camera.pipeline.simulate` (optics, sensor, exposure, ISP) → detector →
 :func:`benchmark.scoring.ap_by_distance`. Outputs, in the results folder:
 
-- ``results.json``: camera, condition, detector, collection, AP/AP50 per distance, OD50;
+- ``results.json``: camera, condition, detector, collection, AP/AP50 per distance, OD50
+  (:class:`benchmark.result_files.RunResults`, where its schema is defined);
 - ``detections.json``: every detection (score ≥ 0.001) in COCO results format, boxes in
   the camera's pixels;
 - ``groundtruth.json``: the collection's ground truth on the camera's grid (scaled, or
@@ -29,7 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
-RESULTS_FORMAT = "metricscenes-results/1"
+from benchmark.result_files import (
+    RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
+    write_results,
+)
+
 AP_SCORE_THRESHOLD = 0.001  # COCO evaluation wants the whole precision-recall curve
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.
@@ -219,11 +224,11 @@ def sha256_bytes(data: bytes) -> str:
 
 
 def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, seed: int = 0,
-               save_images: bool = True, backend: str = "faster-coco-eval", progress=None) -> dict:
+               save_images: bool = True, backend: str = "faster-coco-eval", progress=None) -> RunResults:
     """Simulate ``camera`` on every scene of ``collection`` under ``condition``, detect, score.
 
-    ``progress`` is an optional callable ``(done, total)``. Returns the results dict
-    (also written to ``out_dir/results.json``).
+    ``progress`` is an optional callable ``(done, total)``. Returns the results (also
+    written to ``out_dir/results.json``).
 
     Everything is written to a staging folder inside ``out_dir`` first and moved into place
     only when the run succeeded: a damaged scene or a broken model met halfway leaves
@@ -261,7 +266,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
 
 
 def _run_camera(collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
-                save_images: bool, backend: str, progress) -> dict:
+                save_images: bool, backend: str, progress) -> RunResults:
     """:func:`run_camera`'s work, writing into ``stage``; ``window`` is the part of the
     collection's ``field`` the camera samples (and its ground truth follows)."""
     from PIL import Image
@@ -314,44 +319,45 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     per_distance = ap_by_distance(groundtruth, detections, backend=backend)
     timings.add("score", t)
     detections_bytes = json.dumps(detections, separators=(",", ":")).encode()
-    results = {
-        "format": RESULTS_FORMAT,
-        "package_version": __version__,
-        "camera": {
-            "name": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
-            "width_px": camera.width_px, "height_px": camera.height_px, "spec_sha256": camera.sha256(),
-            "spec": camera.model_dump(mode="json"),
-        },
-        "condition": condition,
-        "detector": {"name": detector.name, "family": detector.family, "sha256": detector.sha256,
-                     "input_size": detector.input_size, "score_threshold": AP_SCORE_THRESHOLD,
-                     "multi_label": True},
-        "collection": {"name": collection.name, "protocol": collection.protocol,
-                       "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
-        "seed": seed,
-        "scoring_backend": backend,
-        "per_distance": per_distance,
-        "od50_m": _finite_or_none(od50([r["distance_m"] for r in per_distance], [r["ap"] for r in per_distance])),
-        "exposure_s": exposures,
-        "detections_file": "detections.json",
-        "detections_sha256": sha256_bytes(detections_bytes),
-        "timing_s": {k: round(v, 3) for k, v in timings.seconds.items()},
-    }
-    if geometry is not None:  # a camera that sees a window of the field (the registry's keep their bytes)
-        results["camera_geometry"] = geometry
+    per_distance = [DistanceAP(**row) for row in per_distance]
+    detector_record = DetectorRecord(name=detector.name, family=detector.family, sha256=detector.sha256,
+                                     input_size=detector.input_size, score_threshold=AP_SCORE_THRESHOLD, multi_label=True)
     class_map = getattr(detector, "class_map", None)
     if class_map is not None:  # a detector with other classes than COCO's 80 (docs/detection.md)
         from benchmark.detectors.classmap import class_map_names
 
-        results["detector"]["class_map"] = class_map_names(class_map)
+        detector_record.class_map = class_map_names(class_map)
+    results = RunResults(
+        format=RESULTS_FORMAT,
+        package_version=__version__,
+        camera=CameraRecord(name=camera.name, pixel_um=camera.pixel_um, f_number=camera.f_number,
+                            width_px=camera.width_px, height_px=camera.height_px, spec_sha256=camera.sha256(),
+                            spec=camera.model_dump(mode="json")),
+        condition=condition,
+        detector=detector_record,
+        collection=CollectionRecord(name=collection.name, protocol=collection.protocol,
+                                    manifest_sha256=collection.manifest_sha256, path=str(collection.root)),
+        seed=seed,
+        scoring_backend=backend,
+        per_distance=per_distance,
+        od50_m=_finite_or_none(od50([r.distance_m for r in per_distance], [r.ap for r in per_distance])),
+        exposure_s=exposures,
+        detections_file="detections.json",
+        detections_sha256=sha256_bytes(detections_bytes),
+        timing_s={k: round(v, 3) for k, v in timings.seconds.items()},
+    )
+    # The optional fields are set only where they apply, so that other results keep their bytes
+    # (results.json holds the fields set: benchmark.result_files).
+    if geometry is not None:  # a camera that sees a window of the field
+        results.camera_geometry = CameraGeometry(**geometry)
     subset = getattr(collection, "subset", None)
     if subset:  # a quick try on part of the collection: never a full run (sweep key, `benchmark submit`)
-        results["subset"] = subset
-    if short_exposures:  # hdr only (other results keep their bytes); exposure_s holds the long frames
-        results["exposure_short_s"] = short_exposures
+        results.subset = Subset(**subset)
+    if short_exposures:  # hdr only; exposure_s holds the long frames
+        results.exposure_short_s = short_exposures
     (stage / "detections.json").write_bytes(detections_bytes)
     (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
-    (stage / "results.json").write_text(json.dumps(results, indent=1))
+    write_results(stage / "results.json", results)
     return results
 
 

@@ -14,13 +14,15 @@ only its missing (or stale) runs. Those runs may go to worker processes or a das
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
 do not depend on where the runs ran.
 
-Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7):
+Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7), their schemas in :mod:`benchmark.result_files`:
 
 - ``sweep.csv`` / ``sweep.json``: one row per camera × condition × distance with
   ``camera, pixel_um, f_number, mtf50_cy_per_mm, mtf50_source, condition, distance_m,
-  ap, ap50, n_images``;
+  ap, ap50, n_images`` (:class:`~benchmark.result_files.SweepRow`; sweep.json:
+  :class:`~benchmark.result_files.SweepRecord`);
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
-  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`).
+  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`;
+  :class:`~benchmark.result_files.Od50Row`).
 
 MTF50 comes from :func:`benchmark.measure.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
 (ISO 12233 slanted edge through the camera), ``analytic`` (diffraction × pixel aperture)
@@ -30,7 +32,6 @@ or ``published_group`` (the paper's MTF50 group of a registry camera).
 from __future__ import annotations
 
 import json
-import math
 import os
 import warnings
 from contextlib import closing
@@ -41,20 +42,21 @@ import numpy as np
 import pandas as pd
 
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
+from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
+from benchmark.result_files import (
+    SWEEP_FORMAT, CollectionRecord, DetectorRecord, Od50Bootstrap, Od50Cache, Od50CacheKey,
+    Od50Row, ResultsFileError, RunResults, Subset, SweepExposure, SweepRecord, SweepRow, SweepRun,
+    read_od50_cache, read_od50_table, read_results, read_sweep_table, write_od50_cache, write_od50_table,
+    write_sweep_record, write_sweep_table,
+)
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.od50 import od50_censoring
-from metricscenes.files import write_atomic
 from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
     from benchmark.camera.spec import ExposureSpec
 
-SWEEP_FORMAT = "metricscenes-sweep/1"
-TABLE_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
-                 "distance_m", "ap", "ap50", "n_images"]
-OD50_COLUMNS = ["camera", "pixel_um", "f_number", "mtf50_cy_per_mm", "mtf50_source", "condition",
-                "od50_m", "sd_m", "ci95_lo_m", "ci95_hi_m", "n_resamples", "n_environments", "n_infinite", "censored"]
-# censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
+# od50.csv's censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
 # extrapolation, report "> farthest m") or "<" (below 0.5 already at the nearest); see benchmark.scoring.od50
 
 
@@ -96,60 +98,60 @@ def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
     return key
 
 
-def results_key(results: dict) -> dict:
-    """The cache key recorded in a ``results.json``."""
-    key = {"camera_spec_sha256": results["camera"]["spec_sha256"], "condition": results["condition"],
-           "model_sha256": results["detector"]["sha256"], "input_size": str(results["detector"]["input_size"]),
-           "manifest_sha256": results["collection"]["manifest_sha256"], "seed": int(results["seed"])}
-    if "camera_geometry" in results:
-        key["camera_geometry"] = results["camera_geometry"]
-    if "subset" in results:
-        key["subset"] = results["subset"]
-    if "class_map" in results["detector"]:
-        key["class_map"] = results["detector"]["class_map"]
+def results_key(results: RunResults) -> dict | None:
+    """The cache key recorded in a ``results.json`` (None for one that names no detector: never reused)."""
+    if results.detector is None:
+        return None
+    key = {"camera_spec_sha256": results.camera.spec_sha256, "condition": results.condition,
+           "model_sha256": results.detector.sha256, "input_size": str(results.detector.input_size),
+           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed}
+    if results.camera_geometry is not None:
+        key["camera_geometry"] = results.camera_geometry.model_dump()
+    if results.subset is not None:
+        key["subset"] = results.subset.model_dump()
+    if results.detector.class_map is not None:
+        key["class_map"] = results.detector.class_map
     return key
 
 
-def cached_results(run_dir: Path, key: dict) -> dict | None:
+def cached_results(run_dir: Path, key: dict) -> RunResults | None:
     """The results of ``run_dir`` if they are complete and carry ``key``, else None."""
     try:
-        results = json.loads((Path(run_dir) / "results.json").read_text())
-        if results_key(results) != key:
-            return None
-    except (OSError, ValueError, KeyError, TypeError):
+        results = read_results(Path(run_dir) / "results.json")
+    except (OSError, ResultsFileError):
         return None  # missing, half-written or foreign: redo
+    if results_key(results) != key:
+        return None
     if not all((Path(run_dir) / name).is_file() for name in ("detections.json", "groundtruth.json")):
         return None
     return results
 
 
-def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> dict:
+def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     """Bootstrap OD50 of one run folder, cached in ``od50.json`` next to its detections."""
     from benchmark.scoring import bootstrap_od50
 
     run_dir = Path(run_dir)
-    results = json.loads((run_dir / "results.json").read_text())
-    key = {"detections_sha256": results.get("detections_sha256"), "n_resamples": int(n_resamples), "seed": int(seed)}
+    results = read_results(run_dir / "results.json")
+    key = Od50CacheKey(detections_sha256=results.detections_sha256, n_resamples=n_resamples, seed=seed)
     cache = run_dir / "od50.json"
     try:
-        stored = json.loads(cache.read_text())
-        if stored.get("key") == key:
-            return stored["od50"]
-    except (OSError, ValueError, AttributeError):
-        pass
+        stored = read_od50_cache(cache)
+        if stored.key == key:
+            return stored.od50
+    except (OSError, ResultsFileError):
+        pass  # none yet, or unreadable: computed again
     gt = json.loads((run_dir / "groundtruth.json").read_text())
     dets = json.loads((run_dir / "detections.json").read_text())
     with warnings.catch_warnings(), np.errstate(invalid="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)  # inf - inf of resamples whose OD50 is infinite
-        out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed,
-                             backend=results.get("scoring_backend", "faster-coco-eval"))
-    out = {**out, "ci95_m": list(out["ci95_m"])}
-    write_atomic(cache, json.dumps({"key": key, "od50": _json_safe(out)}, indent=1))
-    return _json_safe(out)
+        out = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=results.scoring_backend)
+    write_od50_cache(cache, Od50Cache(key=key, od50=out))
+    return out
 
 
 def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
-                backend: str, n_resamples: int, progress=None) -> tuple[str, str, dict]:
+                backend: str, n_resamples: int, progress=None) -> tuple[str, str, RunResults]:
     """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
     backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
     other unit touches. Returns (camera name, condition, results)."""
@@ -232,7 +234,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     total, done = n_scenes * len(cameras) * len(conditions), 0
     run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
                 for camera in cameras for condition in conditions}
-    results: dict[tuple[str, str], dict] = {}
+    results: dict[tuple[str, str], RunResults] = {}
     todo = []
     for camera in cameras:
         for condition in conditions:
@@ -264,43 +266,39 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     rows, od50_rows, runs = [], [], []
     for camera in cameras:
         mtf50, source = camera_mtf50(camera, mtf_source)
-        mtf50 = float("nan") if mtf50 is None else mtf50  # a table cell
         ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
-                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}
+                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}  # mtf50 None: NaN in the tables
         for condition in conditions:
             run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
-            runs.append({"camera": camera.name, "condition": condition, "path": str(run_dir.relative_to(out_dir)),
-                         "reused": (camera.name, condition) in reused})
-            for r in run_results["per_distance"]:
-                rows.append({**ident, "condition": condition, "distance_m": r["distance_m"], "ap": r["ap"],
-                             "ap50": r["ap50"], "n_images": r["n_images"]})
+            runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
+                                 reused=(camera.name, condition) in reused))
+            for r in run_results.per_distance:
+                rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
+                                     n_images=r.n_images))
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
-            lo, hi = boot["ci95_m"]
-            od50_rows.append({**ident, "condition": condition, "od50_m": _num(boot["od50_m"]), "sd_m": _num(boot["sd_m"]),
-                              "ci95_lo_m": _num(lo), "ci95_hi_m": _num(hi), "n_resamples": boot["n_resamples"],
-                              "n_environments": boot["n_environments"], "n_infinite": boot["n_infinite"],
-                              "censored": od50_censoring([r["distance_m"] for r in run_results["per_distance"]],
-                                                         [r["ap"] for r in run_results["per_distance"]])[0]})
+            lo, hi = boot.ci95_m
+            od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
+                                     ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
+                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
 
-    table = pd.DataFrame(rows, columns=TABLE_COLUMNS)
-    od50_table = pd.DataFrame(od50_rows, columns=OD50_COLUMNS)
-    write_atomic(out_dir / "sweep.csv", table.to_csv(index=False))
-    write_atomic(out_dir / "od50.csv", od50_table.to_csv(index=False))
-    meta = {
-        "format": SWEEP_FORMAT,
-        "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
-        "detector": {"name": detector.name, "sha256": detector.sha256, "input_size": str(detector.input_size)},
-        "seed": int(seed), "n_resamples": int(n_resamples), "mtf_source": mtf_source, "scoring_backend": backend,
-        "cameras": names, "conditions": conditions, "runs": runs,
-        "table": _json_safe(table.to_dict(orient="records")),
-        "od50": _json_safe(od50_table.to_dict(orient="records")),
-    }
+    table = write_sweep_table(out_dir / "sweep.csv", rows)
+    od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
+    record = SweepRecord(
+        format=SWEEP_FORMAT,
+        collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
+                                    path=str(collection.root)),
+        detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
+        seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
+        cameras=names, conditions=conditions, runs=runs,
+        # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
+        table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
+    )
     if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
-        meta["subset"] = subset
+        record.subset = Subset(**subset)
     if exposure is not None:  # only then, so that other sweeps keep their bytes
-        meta["exposure"] = {"policy": format_exposure(exposure), "tag": exposure_tag(exposure),
-                            "spec": exposure.model_dump(mode="json")}
-    write_atomic(out_dir / "sweep.json", json.dumps(meta, indent=1))
+        record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
+                                        spec=exposure.model_dump(mode="json"))
+    write_sweep_record(out_dir / "sweep.json", record)
     return table
 
 
@@ -315,10 +313,10 @@ def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def load_sweep(out_dir) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(AP table, OD50 table) of a sweep folder."""
+    """(AP table, OD50 table) of a sweep folder (``sweep.csv``, ``od50.csv``)."""
     out_dir = Path(out_dir)
-    table = pd.read_csv(out_dir / "sweep.csv")
-    return table, with_censoring(pd.read_csv(out_dir / "od50.csv"), table)
+    table = read_sweep_table(out_dir / "sweep.csv")
+    return table, with_censoring(read_od50_table(out_dir / "od50.csv"), table)
 
 
 def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
@@ -337,10 +335,6 @@ def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
     return od50
 
 
-def _num(value) -> float:
-    return float("nan") if value is None else float(value)
-
-
 def od50_cell(row) -> str:
     """One od50.csv row for people: "123.4 ± 5.6", "> 200" or "< 25" (censored: a bound), "∞"."""
     from benchmark.scoring.od50 import format_od50
@@ -349,18 +343,3 @@ def od50_cell(row) -> str:
     bound = row.get("bound_m")
     bound = None if bound is None or bound != bound else float(bound)
     return format_od50(row["od50_m"], censored, bound, row.get("sd_m"), unit="")
-
-
-def _json_safe(value):
-    """Strict JSON: NaN becomes None, ±inf the strings "inf"/"-inf" (``float()`` reads them back)."""
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        if math.isnan(value):
-            return None
-        return float(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
-    if isinstance(value, np.integer):
-        return int(value)
-    return value

@@ -19,13 +19,15 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
+from benchmark.result_files import (
+    RESULTS_FORMAT, DetectorRecord, Od50Bootstrap, Od50CacheKey, ResultsFileError, RunResults, read_od50_cache, read_results,
+)
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
 from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
 from metricscenes.files import sha256_file, write_atomic
 
-RESULTS_FORMAT = "metricscenes-results/1"
 N_RESAMPLES = BOOTSTRAP_RESAMPLES  # the one default (benchmark.scoring.bootstrap)
 
 
@@ -34,15 +36,15 @@ class Run:
     """One run folder and its parsed ``results.json``."""
 
     folder: Path
-    results: dict
+    results: RunResults
 
     @property
     def camera(self) -> str:
-        return self.results["camera"]["name"]
+        return self.results.camera.name
 
     @property
     def condition(self) -> str:
-        return self.results["condition"]
+        return self.results.condition
 
 
 def find_runs(results_dir: str | Path) -> list[Run]:
@@ -57,12 +59,19 @@ def find_runs(results_dir: str | Path) -> list[Run]:
     runs = []
     for folder in folders:
         try:
-            results = json.loads((folder / "results.json").read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            results = read_results(folder / "results.json")
+        except ResultsFileError as exc:  # one line naming the file
+            raise SubmissionError(str(exc)) from None
+        except OSError as exc:
             raise SubmissionError(f"{folder / 'results.json'}: cannot read ({type(exc).__name__})") from None
-        if not isinstance(results, dict) or results.get("format") != RESULTS_FORMAT:
+        if results.format != RESULTS_FORMAT:
             raise SubmissionError(f"{folder / 'results.json'}: not a {RESULTS_FORMAT} file")
-        if results.get("subset"): raise SubmissionError(f"{folder}: a subset run (--environments/--distances) cannot be submitted; submit a run of the whole collection")  # noqa: E701
+        if results.subset: raise SubmissionError(f"{folder}: a subset run (--environments/--distances) cannot be submitted; submit a run of the whole collection")  # noqa: E701
+        # what a submission is built from, which a results.json may lack (hand-made ones)
+        missing = [name for name, value in (("detector", results.detector), ("camera.spec", results.camera.spec),
+                                            ("detections_sha256", results.detections_sha256)) if value is None]
+        if missing:
+            raise SubmissionError(f"{folder / 'results.json'}: no {', '.join(missing)}; a submission needs a run of `benchmark run`")
         runs.append(Run(folder, results))
     return runs
 
@@ -92,11 +101,11 @@ def _none_if_not_finite(x: float) -> float | None:
     return round(float(x), 3) if math.isfinite(x) else None
 
 
-def _detector_licence(detector: dict) -> str:
+def _detector_licence(detector: DetectorRecord) -> str:
     from benchmark.detectors import registry
 
     for entry in registry().values():
-        if entry.sha256 == detector.get("sha256") or entry.name == detector.get("name"):
+        if entry.sha256 == detector.sha256 or entry.name == detector.name:
             return entry.licence
     return "unknown"
 
@@ -111,21 +120,14 @@ def _mtf50(spec, measure: bool) -> tuple[float | None, str]:
     return (round(value, 1) if source in ("measured", "analytic") else value), source
 
 
-def _float(value) -> float:
-    """A JSON number, None (NaN) or "inf"/"-inf" (as the sweep's ``od50.json`` writes them) as a float."""
-    return float("nan") if value is None else float(value)
-
-
-def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> dict | None:
+def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, seed: int) -> Od50Bootstrap | None:
     """The bootstrap a sweep stored in ``<run>/od50.json`` (:func:`benchmark.experiments.sweep.run_od50`), if it is for these settings."""
     try:
-        stored = json.loads((folder / "od50.json").read_text(encoding="utf-8"))
-        if stored["key"] != {"detections_sha256": detections_sha256, "n_resamples": n_resamples, "seed": seed}:
-            return None
-        boot = stored["od50"]
-        return {"sd_m": _float(boot["sd_m"]), "ci95_m": [_float(v) for v in boot["ci95_m"]]}
-    except (OSError, ValueError, KeyError, TypeError):
+        stored = read_od50_cache(folder / "od50.json")
+    except (OSError, ResultsFileError):
         return None
+    key = Od50CacheKey(detections_sha256=detections_sha256, n_resamples=n_resamples, seed=seed)
+    return stored.od50 if stored.key == key else None
 
 
 def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) -> dict:
@@ -133,36 +135,36 @@ def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) 
     from benchmark.scoring import bootstrap_od50, od50
 
     res = run.results
-    det_path = run.folder / res.get("detections_file", "detections.json")
+    det_path = run.folder / res.detections_file
     gt_path = run.folder / "groundtruth.json"
     for p in (det_path, gt_path):
         if not p.is_file():
             raise SubmissionError(f"{run.folder}: {p.name} is missing (needed to verify AP and bootstrap OD50)")
-    if sha256_file(det_path) != res["detections_sha256"]:
+    if sha256_file(det_path) != res.detections_sha256:
         raise SubmissionError(f"{det_path}: sha256 differs from results.json's detections_sha256 (file changed?)")
     entry = {
         "per_distance": [
-            {"distance_m": float(r["distance_m"]), "ap": float(r["ap"]), "ap50": float(r["ap50"]), "n_images": int(r["n_images"])}
-            for r in sorted(res["per_distance"], key=lambda r: r["distance_m"])
+            {"distance_m": r.distance_m, "ap": r.ap, "ap50": r.ap50, "n_images": r.n_images}
+            for r in sorted(res.per_distance, key=lambda r: r.distance_m)
         ],
         "od50_m": None,  # recomputed below from the AP curve, as the validator does
-        "seed": int(res.get("seed", 0)),
-        "detections_sha256": res["detections_sha256"],
+        "seed": res.seed,
+        "detections_sha256": res.detections_sha256,
     }
     entry["od50_m"] = _none_if_not_finite(od50([r["distance_m"] for r in entry["per_distance"]], [r["ap"] for r in entry["per_distance"]]))
-    probe = {"collection": res["collection"], "scoring": {"backend": res.get("scoring_backend", "faster-coco-eval")},
+    probe = {"collection": res.collection.model_dump(), "scoring": {"backend": res.scoring_backend},
              "conditions": {run.condition: entry}}
     verify_detections(probe, [det_path], gt_path, source=str(run.folder / "results.json"))
     gt = json.loads(gt_path.read_text(encoding="utf-8"))
-    boot = _cached_bootstrap(run.folder, res["detections_sha256"], n_resamples, seed)
+    boot = _cached_bootstrap(run.folder, res.detections_sha256, n_resamples, seed)
     if boot is None:
         dets = json.loads(det_path.read_text(encoding="utf-8"))
         with warnings.catch_warnings():  # percentiles of a distribution holding +inf OD50s warn; the CI ends become null
             warnings.simplefilter("ignore", RuntimeWarning)
-            boot = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=probe["scoring"]["backend"])
-    lo, hi = (_float(v) for v in boot["ci95_m"])
+            boot = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=res.scoring_backend)
+    lo, hi = boot.ci95_m
     entry.update({
-        "od50_sd_m": _none_if_not_finite(_float(boot["sd_m"])),
+        "od50_sd_m": _none_if_not_finite(boot.sd_m),
         "od50_ci95_m": [_none_if_not_finite(lo), _none_if_not_finite(hi)],
         "n_environments": len({im["environment_id"] for im in gt["images"]}),
     })  # fmt: skip
@@ -186,22 +188,22 @@ def build_submission(
 
     check_name(name)
     protocols = load_protocols() if protocols is None else protocols
-    if runs and runs[0].results["collection"]["protocol"] in protocols:  # e.g. day@100lux runs of a sweep are not ranked
-        runs = [r for r in runs if r.condition in protocols[runs[0].results["collection"]["protocol"]].conditions]
+    if runs and runs[0].results.collection.protocol in protocols:  # e.g. day@100lux runs of a sweep are not ranked
+        runs = [r for r in runs if r.condition in protocols[runs[0].results.collection.protocol].conditions]
     if not runs:
         raise SubmissionError("no runs to submit (none under a condition the protocol ranks)")
     first = runs[0].results
     for run in runs[1:]:
         r = run.results
-        for label, key in (("camera spec", lambda x: x["camera"]["spec_sha256"]),
-                           ("detector", lambda x: (x["detector"]["sha256"], x["detector"]["input_size"])),
-                           ("collection", lambda x: x["collection"]["manifest_sha256"]),
-                           ("scoring backend", lambda x: x.get("scoring_backend"))):  # fmt: skip
+        for label, key in (("camera spec", lambda x: x.camera.spec_sha256),
+                           ("detector", lambda x: (x.detector.sha256, x.detector.input_size)),
+                           ("collection", lambda x: x.collection.manifest_sha256),
+                           ("scoring backend", lambda x: x.scoring_backend)):  # fmt: skip
             if key(r) != key(first):
                 raise SubmissionError(f"{run.folder}: {label} differs from {runs[0].folder}'s; one submission is one camera system")
-    spec = camera_from_dump(first["camera"]["spec"], source=f"{runs[0].folder}/results.json camera.spec")
+    spec = camera_from_dump(first.camera.spec, source=f"{runs[0].folder}/results.json camera.spec")
     mtf50, mtf50_source = _mtf50(spec, measure_mtf)
-    det = first["detector"]
+    det = first.detector
     submission = {
         "format": SUBMISSION_FORMAT,
         "name": name,
@@ -211,17 +213,18 @@ def build_submission(
         "camera": {"name": spec.name, "spec_sha256": spec.sha256(), "spec": spec.model_dump(mode="json"),
                    "mtf50_cy_per_mm": mtf50, "mtf50_source": mtf50_source},
         "isp": spec.isp.model_dump(mode="json"),
-        "detector": {"name": det["name"], "family": det["family"], "sha256": det["sha256"], "licence": _detector_licence(det),
-                     "input_size": det["input_size"], "score_threshold": det["score_threshold"],
-                     "multi_label": bool(det.get("multi_label", False))},
-        "collection": {k: first["collection"][k] for k in ("name", "protocol", "manifest_sha256")},
-        "scoring": {"backend": first.get("scoring_backend", "faster-coco-eval"), "category_id": 3,
+        "detector": {"name": det.name, "family": det.family, "sha256": det.sha256, "licence": _detector_licence(det),
+                     "input_size": det.input_size, "score_threshold": det.score_threshold,
+                     "multi_label": bool(det.multi_label)},
+        "collection": {"name": first.collection.name, "protocol": first.collection.protocol,
+                       "manifest_sha256": first.collection.manifest_sha256},
+        "scoring": {"backend": first.scoring_backend, "category_id": 3,
                     "bootstrap_resamples": n_resamples, "bootstrap_seed": seed},
         "conditions": {run.condition: condition_entry(run, n_resamples=n_resamples, seed=seed) for run in runs},
     }  # fmt: skip
     if notes:
         submission["notes"] = notes
-    if spec.sha256() != first["camera"]["spec_sha256"]:
+    if spec.sha256() != first.camera.spec_sha256:
         raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")
     return validate_submission(submission, protocols=protocols, source=name)
 

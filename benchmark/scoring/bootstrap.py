@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from benchmark.result_files import Od50Bootstrap
 from benchmark.scoring.ap import ALL_AREAS, MAX_DETS, ap_by_distance, images_by_distance
 from benchmark.scoring.od50 import od50, od50_censoring
 
@@ -161,11 +162,12 @@ def bootstrap_od50(
     backend: str = "faster-coco-eval",
     category_id: int = 3,
     confidence_level: float = 0.95,
-) -> dict:
+) -> Od50Bootstrap:
     """OD50 (from the full set, ``backend``) with its bootstrap SD and percentile CI over environments.
 
-    Returns ``{od50_m, sd_m, ci95_m: (lo, hi), n_resamples, n_environments, n_infinite,
-    censored, bound_m}`` (``censored``: "", ">" or "<" of the full set, :func:`od50_censoring`);
+    Returns an :class:`~benchmark.result_files.Od50Bootstrap`: ``od50_m``, ``sd_m``,
+    ``ci95_m`` (lo, hi), ``n_resamples``, ``n_environments``, ``n_infinite``, ``censored``
+    and ``bound_m`` ("", ">" or "<" of the full set and its bound, :func:`od50_censoring`);
     ``sd_m`` is the SD (ddof 1) of the finite resampled OD50s, ``n_infinite`` counts
     resamples whose AP never falls to 0.5 (OD50 = inf; they still enter the CI).
     """
@@ -197,16 +199,16 @@ def bootstrap_od50(
     dist = np.asarray(res.bootstrap_distribution, dtype=np.float64)
     finite = dist[np.isfinite(dist)]
     lo, hi = percentile_interval(dist, confidence_level)
-    return {
-        "od50_m": float(point),
-        "sd_m": float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
-        "ci95_m": (float(lo), float(hi)),
-        "n_resamples": int(n_resamples),
-        "n_environments": len(envs),
-        "n_infinite": int(dist.size - finite.size),
-        "censored": censored,
-        "bound_m": bound_m,
-    }
+    return Od50Bootstrap(
+        od50_m=float(point),
+        sd_m=float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
+        ci95_m=(float(lo), float(hi)),
+        n_resamples=int(n_resamples),
+        n_environments=len(envs),
+        n_infinite=int(dist.size - finite.size),
+        censored=censored,
+        bound_m=bound_m,
+    )
 
 
 def percentile_interval(values: np.ndarray, confidence_level: float = 0.95) -> tuple[float, float]:
