@@ -11,7 +11,7 @@ noise (issue 11.5; results in docs/performance.md, "Store size").
 Codec study (default): every radiance array of the chosen environments (their plates, and
 the insets and car-lamp frames of their six scenes; every light group: day, dusk, night,
 lamps) is written to a scratch store under each chain, then read back and compared with
-the original bits (BitRound chains: with :func:`metricscenes.store.round_mantissa`'s
+the original bits (BitRound chains: with :func:`metricscenes.writer.round_mantissa`'s
 values). Bytes are the chunk files'; ratios are against zarr's default chain (bytes + zstd
 level 0), what collections were written with before, measured in the same run. Speeds are
 MB of raw float32 per second (these machines are shared: compare within a run).
@@ -26,7 +26,7 @@ after the band sum a camera makes (luminance): see :func:`noise_and_rounding`. R
 kept under ``--work`` and reused.
 
 ``--whole``: rewrites every array of the collection with the store's writer
-(``write_radiance`` / ``write_mask``: the lossless default, and BitRound at each
+(``UnitArrays.write_radiance`` / ``write_mask``: the lossless default, and BitRound at each
 ``--mantissa-bits``) into scratch copies, checks that the lossless copy verifies against the
 collection's recorded sha256, prints the store sizes, and extrapolates them to one
 environment of metric-300 (its plates, frames and insets sized by its own plan); the copies
@@ -48,9 +48,9 @@ from pathlib import Path
 import numpy as np
 
 from metricscenes.store import (
-    GROUNDTRUTH_FILE, RADIANCE_COMPRESSORS, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, Collection, array_sha256,
-    read_checked, round_mantissa, verify_collection, write_mask, write_radiance,
+    GROUNDTRUTH_FILE, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, Collection, array_sha256, read_checked, verify_collection,
 )
+from metricscenes.writer import RADIANCE_COMPRESSORS, CollectionWriter, round_mantissa
 
 MB = 1e6
 ZARR_DEFAULT = "zstd 0 (zarr default: collections so far)"
@@ -245,6 +245,7 @@ def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndar
 
     from metricscenes.generate import plan_units, render_unit
     from metricscenes.plan import plan_collection
+    from metricscenes.render import resolve_variant
 
     unit = next((u for u in plan_units(plan_collection(manifest)) if u.key == unit_key), None)
     if unit is None:
@@ -256,8 +257,9 @@ def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndar
         if not record_file.is_file():
             root.mkdir(parents=True, exist_ok=True)
             started = time.perf_counter()
-            record = render_unit(manifest.model_dump(mode="json"), replace(unit, seed=seed), str(root), None)
-            record_file.write_text(json.dumps(record))
+            record = render_unit(manifest.model_dump(mode="json"), replace(unit, seed=seed), str(root), None,
+                                 resolve_variant(manifest.render.variant))
+            record_file.write_text(record.to_json())
             print(f"  rendered {unit_key} with seed {seed} in {time.perf_counter() - started:.0f} s", flush=True)
         records.append((root, json.loads(record_file.read_text())))
     pairs = {}
@@ -361,11 +363,12 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
         data, attrs = read_checked(collection.root, group, path, arrays.get(path), path)
         extent = TanExtent(*attrs["extent_tan"])
         if path.startswith("masks/"):
-            written[path] = write_mask(out, path.split("/")[1], data, extent)
+            written[path] = CollectionWriter(out).unit_arrays(path.split("/")[1]).write_mask(data, extent)
         else:
             kind, unit, light_group = path.split("/")
             extra = {k: v for k, v in attrs.items() if k in ("spp", "seed")}
-            written[path] = write_radiance(out, kind, unit, light_group, data, extent, extra, mantissa_bits)
+            unit_arrays = CollectionWriter(out).unit_arrays(unit, mantissa_bits)
+            written[path] = unit_arrays.write_radiance(kind, light_group, data, extent, extra)
     return out, written
 
 

@@ -1,4 +1,6 @@
-"""The collection store: the only way to read (and write) a rendered collection.
+"""The collection store: how a rendered collection is laid out, and its read side
+(:class:`Collection`, :func:`verify_collection`); :mod:`metricscenes.writer` is its write
+side (``CollectionWriter``), and nothing else writes a collection.
 
 Layout of a collection folder::
 
@@ -16,21 +18,15 @@ Layout of a collection folder::
     progress/render_variant             manifest, or with another variant, is refused)
 
 Every array is one chunk written by one unit of work, so workers never share a file.
+The resolved manifest and the progress records are typed in :mod:`metricscenes.records`.
 Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)
 and ``light_group``. A light group that puts no light in a unit (e.g. street lights
 on a road without any) has no array: it reads as zero. Which arrays a unit has is
 what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
 
-Codecs: radiance chunks are encoded as bytes (little-endian) + Blosc (zstd level 1, byte
-shuffle, the chunk as one block): codecs of the zarr v3 core specification, lossless, so
-the values and their sha256 are the ones rendered (:data:`RADIANCE_COMPRESSORS`).
-Collections written before with zarr's default (bytes + zstd level 0) read the same:
-zarr takes each array's chain from its ``zarr.json``. A manifest's ``store:
-{mantissa_bits: N}`` rounds radiance to N of float32's 23 mantissa bits before the write
-(BitRound, :func:`round_mantissa`): at most 2^-(N+1) relative error per value (RMS about
-2^-N / sqrt(12)); the sha256 recorded is the rounded values', and such arrays carry a
-``mantissa_bits`` attribute. Sizes, times and the error against the render's own noise:
-docs/performance.md, "Store size".
+Codecs (:mod:`metricscenes.writer`): radiance is stored losslessly with zarr v3 core
+codecs unless the manifest asks for ``store: {mantissa_bits: N}``; zarr reads each array's
+chain from its ``zarr.json``, so collections written with older chains read the same.
 
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
@@ -52,9 +48,9 @@ import yaml
 
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
-from metricscenes.manifest import canonical_sha256, illuminance_condition, manifest_sha256, parse_illuminance_condition
+from metricscenes.manifest import illuminance_condition, manifest_sha256, parse_illuminance_condition
 from metricscenes.radiance import RadianceLayer, SpectralScene
-from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
+from metricscenes.records import resolved_content_sha256
 
 RADIANCE_STORE = "radiance.zarr"
 GROUNDTRUTH_FILE = "groundtruth.json"
@@ -62,22 +58,6 @@ RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
 PROGRESS_DIR = "progress"
 DIMENSIONS = ("y", "x", "wavelength")
 REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
-# Arrays are always written with their chunk, even an all-zero one, so that a missing
-# chunk file is damage (zarr would otherwise read it as fill-value zeros).
-WRITE_CONFIG = {"write_empty_chunks": True}
-# Radiance chunks: bytes (little-endian), then Blosc: byte shuffle and zstd level 1 over the
-# whole chunk as one block; all codecs of the zarr v3 core specification (any v3 reader
-# decodes them). Monte Carlo noise fills the low mantissa bytes, which no lossless coder
-# shrinks; the shuffle puts the sign-exponent bytes of all values together, where they
-# compress well. Against zarr's default (bytes + zstd level 0, what collections were written
-# with before: they still read) 6 % smaller, written 3x faster, read as fast (measured by
-# benchmarks/store_codecs.py: docs/performance.md, "Store size").
-RADIANCE_COMPRESSORS = ({"name": "blosc", "configuration": {"cname": "zstd", "clevel": 1, "shuffle": "shuffle",
-                                                             "typesize": 4, "blocksize": 2**30}},)
-# c-blosc 1 refuses buffers of 2 GiB or more: such a chunk (a film the manifest's bounds allow
-# only on a very large machine) is written with zarr's default zstd instead.
-BLOSC_MAX_BYTES = 2**31 - 64
-ZARR_DEFAULT_COMPRESSORS = ({"name": "zstd", "configuration": {"level": 0, "checksum": False}},)
 
 
 class CollectionError(ValueError):
@@ -95,11 +75,6 @@ def array_sha256(array: np.ndarray) -> str:
     h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
     h.update(a.tobytes())
     return h.hexdigest()
-
-
-def resolved_content_sha256(resolved: dict) -> str:
-    """sha256 of a resolved manifest's content, its own ``content_sha256`` left out."""
-    return canonical_sha256({k: v for k, v in resolved.items() if k != "content_sha256"})
 
 
 def _fingerprint(root: Path, path: str) -> tuple:
@@ -183,65 +158,6 @@ def collection_containing(path: str | Path) -> Path | None:
                 or (folder / PROGRESS_DIR / "manifest_sha256").is_file()):
             return folder
     return None
-
-
-def round_mantissa(values: np.ndarray, mantissa_bits: int) -> np.ndarray:
-    """float32 values rounded to nearest (ties to even) with ``mantissa_bits`` of their 23
-    explicit mantissa bits kept: numcodecs' BitRound (Klöwer et al. 2021, "Compressing
-    atmospheric data into its real information content", Nat. Comput. Sci. 1, 713-724).
-
-    The relative error of a normal value is at most 2^-(mantissa_bits + 1) (its RMS over
-    many values about 2^-mantissa_bits / sqrt(12)); zeros stay zero and the sign is kept.
-    The zeroed low bits are what makes the chunk compress."""
-    from numcodecs import BitRound
-
-    a = np.ascontiguousarray(values, dtype=np.float32)
-    return np.asarray(BitRound(keepbits=mantissa_bits).encode(a)).view(np.float32)
-
-
-def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,
-                   extent: TanExtent, extra_attrs: dict | None = None, mantissa_bits: int | None = None) -> str:
-    """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`);
-    return the sha256 of the values stored.
-
-    ``mantissa_bits`` (the manifest's ``store.mantissa_bits``; None: lossless) rounds the
-    values first (:func:`round_mantissa`), so the sha256 is that of the rounded values, and
-    records the width in the array's ``mantissa_bits`` attribute."""
-    import zarr
-
-    cube = np.ascontiguousarray(cube, dtype=np.float32)
-    if mantissa_bits is not None:
-        cube = round_mantissa(cube, mantissa_bits)
-    attrs = {
-        "units": RADIANCE_UNITS,
-        "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
-        "extent_tan": list(extent.as_tuple()),
-        "light_group": light_group,
-        **({} if mantissa_bits is None else {"mantissa_bits": mantissa_bits}),
-        **(extra_attrs or {}),
-    }
-    arr = zarr.create_array(
-        store=str(root / RADIANCE_STORE), name=f"{kind}/{unit}/{light_group}", shape=cube.shape,
-        dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
-        compressors=RADIANCE_COMPRESSORS if cube.nbytes <= BLOSC_MAX_BYTES else ZARR_DEFAULT_COMPRESSORS,
-        overwrite=True, config=WRITE_CONFIG,
-    )
-    arr[...] = cube
-    return array_sha256(cube)
-
-
-def write_mask(root: Path, unit: str, mask: np.ndarray, extent: TanExtent) -> str:
-    """Write a scene's instance mask (True = car) over its inset window; return its sha256."""
-    import zarr
-
-    mask = np.ascontiguousarray(mask, dtype=bool)
-    arr = zarr.create_array(
-        store=str(root / RADIANCE_STORE), name=f"masks/{unit}", shape=mask.shape, dtype="bool",
-        chunks=mask.shape, dimension_names=("y", "x"), overwrite=True, config=WRITE_CONFIG,
-        attributes={"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"},
-    )
-    arr[...] = mask
-    return array_sha256(mask)
 
 
 @dataclass(frozen=True)
