@@ -154,7 +154,7 @@ def subset_arrays(collection: Collection, environments: list[int]) -> list[str]:
     """The radiance arrays of these environments: plates, and their scenes' insets and frames."""
     scenes = {s.scene_id for s in collection.scenes() if s.environment_id in environments}
     units = scenes | {f"env{e:03d}" for e in environments}
-    return [p for p in sorted(collection.resolved["arrays"]) if not p.startswith("masks/")
+    return [p for p in sorted(collection.resolved.arrays) if not p.startswith("masks/")
             and p.split("/")[1] in units]
 
 
@@ -195,7 +195,7 @@ def codec_study(collection: Collection, environments: list[int], widths: list[in
     print(f"codec study: {collection.root}, environments {environments}: {len(paths)} arrays, {n_scenes} scenes; "
           f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}", flush=True)
     for path in paths:
-        cube, _ = read_checked(collection.root, group, path, collection.resolved["arrays"][path], path)
+        cube, _ = read_checked(collection.root, group, path, collection.resolved.arrays[path], path)
         cube = np.ascontiguousarray(cube, dtype=np.float32)
         raw[path] = cube.nbytes
         for name, (bits, codecs) in chains.items():
@@ -312,7 +312,7 @@ def noise_manifest(collection: Collection, manifest_path: Path | None, light_gro
     metric-300: its grid and spp), with only ``light_groups`` rendered (they cost the time)."""
     from metricscenes.manifest import load_manifest, parse_manifest
 
-    manifest = load_manifest(manifest_path) if manifest_path else parse_manifest(collection.manifest)
+    manifest = load_manifest(manifest_path) if manifest_path else collection.manifest
     if not light_groups:
         return manifest
     data = manifest.model_dump(mode="json", exclude={"store", "illuminance_sweep"})
@@ -329,7 +329,7 @@ def noise_study(collection: Collection, manifest, units: list[str], widths: list
     rows = []
     for unit in units:
         for path, (a, b) in render_twice(manifest, unit, work / unit).items():
-            same = (array_sha256(a) == collection.resolved["arrays"].get(path)
+            same = (array_sha256(a) == collection.resolved.arrays.get(path)
                     if manifest.sha256() == collection.manifest_sha256 else None)  # None: another manifest
             rows.append((path, same, noise_and_rounding(a, b, widths)))
     for name in ("band", "luminance"):
@@ -355,7 +355,7 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
     (out / RADIANCE_STORE).mkdir(parents=True)
     shutil.copy(collection.root / RADIANCE_STORE / "zarr.json", out / RADIANCE_STORE / "zarr.json")  # root attributes
     group = radiance_group(collection)
-    arrays = collection.resolved["arrays"]
+    arrays = collection.resolved.arrays
     # every scene's mask (collections written before masks had a sha256 do not list them)
     paths = sorted({*arrays, *(f"masks/{s.scene_id}" for s in collection.scenes())})
     written = {}
@@ -410,7 +410,7 @@ def whole_store(collection: Collection, widths: list[int], work: Path, metric300
         if bits is None:  # the lossless copy is the same collection: every recorded sha256 must hold
             for name_ in (RESOLVED_MANIFEST_FILE, GROUNDTRUTH_FILE):
                 shutil.copy(collection.root / name_, out / name_)
-            same = all(written[path] == sha for path, sha in collection.resolved["arrays"].items())
+            same = all(written[path] == sha for path, sha in collection.resolved.arrays.items())
             problems = verify_collection(out)
             print(f"  lossless copy: every sha256 equals the recorded one: {same}; verify: "
                   f"{'no problems' if not problems else problems[:3]}", flush=True)
@@ -419,7 +419,7 @@ def whole_store(collection: Collection, widths: list[int], work: Path, metric300
     # Bytes per kind, and per pixel of a unit (summed over its light groups), for the extrapolation.
     pixels = {}
     group = radiance_group(collection)
-    for path in collection.resolved["arrays"]:
+    for path in collection.resolved.arrays:
         kind, unit = path.split("/")[:2]
         if kind != "masks":
             pixels[(kind, unit)] = math.prod(group[path].shape[:2])

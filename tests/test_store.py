@@ -145,7 +145,7 @@ def test_generate_with_bitround_is_deterministic_and_verifies(smoke_collection, 
     for path, sha in resolved["arrays"].items():
         stored, attrs, _ = _read(root, path)
         if path.startswith("masks/"):
-            assert sha == lossless.resolved["arrays"][path]
+            assert sha == lossless.resolved.arrays[path]
             continue
         original, _, _ = _read(smoke_collection, path)
         assert np.array_equal(stored.view(np.uint32), round_mantissa(original, 8).view(np.uint32))
