@@ -3,9 +3,9 @@
 Units of work are the plates (one per environment: its background without the car,
 once per light group) and the insets (one per scene: a window around the car at
 finer angular sampling, once per light group, plus a whole frame of the car's own
-lamps at plate sampling, since their light reaches far beyond the window). Each unit writes its own zarr arrays
-and then a small record under ``progress/``, all through :class:`metricscenes.writer.CollectionWriter`;
-a rerun skips units whose record exists
+lamps at plate sampling, since their light reaches far beyond the window). Each unit
+writes its own zarr arrays and then a small record under ``progress/``, all through
+:class:`metricscenes.writer.CollectionWriter`; a rerun skips units whose record exists
 and whose arrays still match the record's sha256 (a damaged or deleted array is
 rendered again), so a killed run resumes and a damaged collection is repaired, and
 because every unit is a pure function of the manifest the result is bit-identical to
