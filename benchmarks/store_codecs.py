@@ -11,7 +11,7 @@ noise (issue 11.5; results in docs/performance.md, "Store size").
 Codec study (default): every radiance array of the chosen environments (their plates, and
 the insets and car-lamp frames of their six scenes; every light group: day, dusk, night,
 lamps) is written to a scratch store under each chain, then read back and compared with
-the original bits (BitRound chains: with :func:`metricscenes.store.round_mantissa`'s
+the original bits (BitRound chains: with :func:`metricscenes.writer.round_mantissa`'s
 values). Bytes are the chunk files'; ratios are against zarr's default chain (bytes + zstd
 level 0), what collections were written with before, measured in the same run. Speeds are
 MB of raw float32 per second (these machines are shared: compare within a run).
@@ -26,7 +26,7 @@ after the band sum a camera makes (luminance): see :func:`noise_and_rounding`. R
 kept under ``--work`` and reused.
 
 ``--whole``: rewrites every array of the collection with the store's writer
-(``write_radiance`` / ``write_mask``: the lossless default, and BitRound at each
+(``UnitArrays.write_radiance`` / ``write_mask``: the lossless default, and BitRound at each
 ``--mantissa-bits``) into scratch copies, checks that the lossless copy verifies against the
 collection's recorded sha256, prints the store sizes, and extrapolates them to one
 environment of metric-300 (its plates, frames and insets sized by its own plan); the copies
@@ -48,9 +48,9 @@ from pathlib import Path
 import numpy as np
 
 from metricscenes.store import (
-    GROUNDTRUTH_FILE, RADIANCE_COMPRESSORS, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, Collection, array_sha256,
-    read_checked, round_mantissa, verify_collection, write_mask, write_radiance,
+    GROUNDTRUTH_FILE, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, Collection, array_sha256, read_checked, verify_collection,
 )
+from metricscenes.writer import RADIANCE_COMPRESSORS, CollectionWriter, round_mantissa
 
 MB = 1e6
 ZARR_DEFAULT = "zstd 0 (zarr default: collections so far)"
@@ -154,7 +154,7 @@ def subset_arrays(collection: Collection, environments: list[int]) -> list[str]:
     """The radiance arrays of these environments: plates, and their scenes' insets and frames."""
     scenes = {s.scene_id for s in collection.scenes() if s.environment_id in environments}
     units = scenes | {f"env{e:03d}" for e in environments}
-    return [p for p in sorted(collection.resolved["arrays"]) if not p.startswith("masks/")
+    return [p for p in sorted(collection.resolved.arrays) if not p.startswith("masks/")
             and p.split("/")[1] in units]
 
 
@@ -195,7 +195,7 @@ def codec_study(collection: Collection, environments: list[int], widths: list[in
     print(f"codec study: {collection.root}, environments {environments}: {len(paths)} arrays, {n_scenes} scenes; "
           f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}", flush=True)
     for path in paths:
-        cube, _ = read_checked(collection.root, group, path, collection.resolved["arrays"][path], path)
+        cube, _ = read_checked(collection.root, group, path, collection.resolved.arrays[path], path)
         cube = np.ascontiguousarray(cube, dtype=np.float32)
         raw[path] = cube.nbytes
         for name, (bits, codecs) in chains.items():
@@ -245,6 +245,7 @@ def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndar
 
     from metricscenes.generate import plan_units, render_unit
     from metricscenes.plan import plan_collection
+    from metricscenes.render import resolve_variant
 
     unit = next((u for u in plan_units(plan_collection(manifest)) if u.key == unit_key), None)
     if unit is None:
@@ -256,8 +257,9 @@ def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndar
         if not record_file.is_file():
             root.mkdir(parents=True, exist_ok=True)
             started = time.perf_counter()
-            record = render_unit(manifest.model_dump(mode="json"), replace(unit, seed=seed), str(root), None)
-            record_file.write_text(json.dumps(record))
+            record = render_unit(manifest.model_dump(mode="json"), replace(unit, seed=seed), str(root), None,
+                                 resolve_variant(manifest.render.variant))
+            record_file.write_text(record.to_json())
             print(f"  rendered {unit_key} with seed {seed} in {time.perf_counter() - started:.0f} s", flush=True)
         records.append((root, json.loads(record_file.read_text())))
     pairs = {}
@@ -310,7 +312,7 @@ def noise_manifest(collection: Collection, manifest_path: Path | None, light_gro
     metric-300: its grid and spp), with only ``light_groups`` rendered (they cost the time)."""
     from metricscenes.manifest import load_manifest, parse_manifest
 
-    manifest = load_manifest(manifest_path) if manifest_path else parse_manifest(collection.manifest)
+    manifest = load_manifest(manifest_path) if manifest_path else collection.manifest
     if not light_groups:
         return manifest
     data = manifest.model_dump(mode="json", exclude={"store", "illuminance_sweep"})
@@ -327,7 +329,7 @@ def noise_study(collection: Collection, manifest, units: list[str], widths: list
     rows = []
     for unit in units:
         for path, (a, b) in render_twice(manifest, unit, work / unit).items():
-            same = (array_sha256(a) == collection.resolved["arrays"].get(path)
+            same = (array_sha256(a) == collection.resolved.arrays.get(path)
                     if manifest.sha256() == collection.manifest_sha256 else None)  # None: another manifest
             rows.append((path, same, noise_and_rounding(a, b, widths)))
     for name in ("band", "luminance"):
@@ -353,7 +355,7 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
     (out / RADIANCE_STORE).mkdir(parents=True)
     shutil.copy(collection.root / RADIANCE_STORE / "zarr.json", out / RADIANCE_STORE / "zarr.json")  # root attributes
     group = radiance_group(collection)
-    arrays = collection.resolved["arrays"]
+    arrays = collection.resolved.arrays
     # every scene's mask (collections written before masks had a sha256 do not list them)
     paths = sorted({*arrays, *(f"masks/{s.scene_id}" for s in collection.scenes())})
     written = {}
@@ -361,11 +363,12 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
         data, attrs = read_checked(collection.root, group, path, arrays.get(path), path)
         extent = TanExtent(*attrs["extent_tan"])
         if path.startswith("masks/"):
-            written[path] = write_mask(out, path.split("/")[1], data, extent)
+            written[path] = CollectionWriter(out).unit_arrays(path.split("/")[1]).write_mask(data, extent)
         else:
             kind, unit, light_group = path.split("/")
             extra = {k: v for k, v in attrs.items() if k in ("spp", "seed")}
-            written[path] = write_radiance(out, kind, unit, light_group, data, extent, extra, mantissa_bits)
+            unit_arrays = CollectionWriter(out).unit_arrays(unit, mantissa_bits)
+            written[path] = unit_arrays.write_radiance(kind, light_group, data, extent, extra)
     return out, written
 
 
@@ -407,7 +410,7 @@ def whole_store(collection: Collection, widths: list[int], work: Path, metric300
         if bits is None:  # the lossless copy is the same collection: every recorded sha256 must hold
             for name_ in (RESOLVED_MANIFEST_FILE, GROUNDTRUTH_FILE):
                 shutil.copy(collection.root / name_, out / name_)
-            same = all(written[path] == sha for path, sha in collection.resolved["arrays"].items())
+            same = all(written[path] == sha for path, sha in collection.resolved.arrays.items())
             problems = verify_collection(out)
             print(f"  lossless copy: every sha256 equals the recorded one: {same}; verify: "
                   f"{'no problems' if not problems else problems[:3]}", flush=True)
@@ -416,7 +419,7 @@ def whole_store(collection: Collection, widths: list[int], work: Path, metric300
     # Bytes per kind, and per pixel of a unit (summed over its light groups), for the extrapolation.
     pixels = {}
     group = radiance_group(collection)
-    for path in collection.resolved["arrays"]:
+    for path in collection.resolved.arrays:
         kind, unit = path.split("/")[:2]
         if kind != "masks":
             pixels[(kind, unit)] = math.prod(group[path].shape[:2])

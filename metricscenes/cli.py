@@ -111,12 +111,11 @@ def info(
     size = sum(p.stat().st_size for p in (collection / "radiance.zarr").rglob("*") if p.is_file())
     summary = {
         "name": c.name, "protocol": c.protocol, "manifest_sha256": c.manifest_sha256,
-        "package_version": c.resolved["package_version"],
-        # (collections made before render.variant: auto record none: their manifest's variant rendered them)
-        "render_variant": c.resolved.get("render_variant", c.manifest["render"]["variant"]), "scenes": len(scenes),
+        "package_version": c.resolved.package_version,
+        "render_variant": c.render_variant, "scenes": len(scenes),
         "environments": len({s.environment_id for s in scenes}),
         "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.condition_names,
-        "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved["arrays"]),
+        "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved.arrays),
         "radiance_units": "W sr-1 m-2 nm-1", "wavelengths_nm": [400, 700, 10], "store_bytes": size,
     }
     if photometry:

@@ -127,7 +127,7 @@ def parse_illuminance_condition(condition: str) -> tuple[str, float] | None:
 
 
 class StoreSettings(_Strict):
-    """How radiance is stored (``metricscenes.store.write_radiance``). Without ``store``
+    """How radiance is stored (``metricscenes.writer.UnitArrays.write_radiance``). Without ``store``
     every value is stored exactly (lossless)."""
 
     mantissa_bits: Int = Field(

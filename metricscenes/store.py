@@ -1,4 +1,6 @@
-"""The collection store: the only way to read (and write) a rendered collection.
+"""The collection store: how a rendered collection is laid out, and its read side
+(:class:`Collection`, :func:`verify_collection`); :mod:`metricscenes.writer` is its write
+side (``CollectionWriter``), and nothing else writes a collection.
 
 Layout of a collection folder::
 
@@ -16,21 +18,15 @@ Layout of a collection folder::
     progress/render_variant             manifest, or with another variant, is refused)
 
 Every array is one chunk written by one unit of work, so workers never share a file.
+The resolved manifest and the progress records are typed in :mod:`metricscenes.records`.
 Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)
 and ``light_group``. A light group that puts no light in a unit (e.g. street lights
 on a road without any) has no array: it reads as zero. Which arrays a unit has is
 what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
 
-Codecs: radiance chunks are encoded as bytes (little-endian) + Blosc (zstd level 1, byte
-shuffle, the chunk as one block): codecs of the zarr v3 core specification, lossless, so
-the values and their sha256 are the ones rendered (:data:`RADIANCE_COMPRESSORS`).
-Collections written before with zarr's default (bytes + zstd level 0) read the same:
-zarr takes each array's chain from its ``zarr.json``. A manifest's ``store:
-{mantissa_bits: N}`` rounds radiance to N of float32's 23 mantissa bits before the write
-(BitRound, :func:`round_mantissa`): at most 2^-(N+1) relative error per value (RMS about
-2^-N / sqrt(12)); the sha256 recorded is the rounded values', and such arrays carry a
-``mantissa_bits`` attribute. Sizes, times and the error against the render's own noise:
-docs/performance.md, "Store size".
+Codecs (:mod:`metricscenes.writer`): radiance is stored losslessly with zarr v3 core
+codecs unless the manifest asks for ``store: {mantissa_bits: N}``; zarr reads each array's
+chain from its ``zarr.json``, so collections written with older chains read the same.
 
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
@@ -52,9 +48,11 @@ import yaml
 
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
-from metricscenes.manifest import canonical_sha256, illuminance_condition, manifest_sha256, parse_illuminance_condition
+from metricscenes.manifest import (
+    Manifest, ManifestError, illuminance_condition, manifest_sha256, parse_illuminance_condition, parse_manifest,
+)
 from metricscenes.radiance import RadianceLayer, SpectralScene
-from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
+from metricscenes.records import ResolvedManifest, resolved_content_sha256
 
 RADIANCE_STORE = "radiance.zarr"
 GROUNDTRUTH_FILE = "groundtruth.json"
@@ -62,22 +60,6 @@ RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
 PROGRESS_DIR = "progress"
 DIMENSIONS = ("y", "x", "wavelength")
 REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
-# Arrays are always written with their chunk, even an all-zero one, so that a missing
-# chunk file is damage (zarr would otherwise read it as fill-value zeros).
-WRITE_CONFIG = {"write_empty_chunks": True}
-# Radiance chunks: bytes (little-endian), then Blosc: byte shuffle and zstd level 1 over the
-# whole chunk as one block; all codecs of the zarr v3 core specification (any v3 reader
-# decodes them). Monte Carlo noise fills the low mantissa bytes, which no lossless coder
-# shrinks; the shuffle puts the sign-exponent bytes of all values together, where they
-# compress well. Against zarr's default (bytes + zstd level 0, what collections were written
-# with before: they still read) 6 % smaller, written 3x faster, read as fast (measured by
-# benchmarks/store_codecs.py: docs/performance.md, "Store size").
-RADIANCE_COMPRESSORS = ({"name": "blosc", "configuration": {"cname": "zstd", "clevel": 1, "shuffle": "shuffle",
-                                                             "typesize": 4, "blocksize": 2**30}},)
-# c-blosc 1 refuses buffers of 2 GiB or more: such a chunk (a film the manifest's bounds allow
-# only on a very large machine) is written with zarr's default zstd instead.
-BLOSC_MAX_BYTES = 2**31 - 64
-ZARR_DEFAULT_COMPRESSORS = ({"name": "zstd", "configuration": {"level": 0, "checksum": False}},)
 
 
 class CollectionError(ValueError):
@@ -95,11 +77,6 @@ def array_sha256(array: np.ndarray) -> str:
     h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
     h.update(a.tobytes())
     return h.hexdigest()
-
-
-def resolved_content_sha256(resolved: dict) -> str:
-    """sha256 of a resolved manifest's content, its own ``content_sha256`` left out."""
-    return canonical_sha256({k: v for k, v in resolved.items() if k != "content_sha256"})
 
 
 def _fingerprint(root: Path, path: str) -> tuple:
@@ -185,65 +162,6 @@ def collection_containing(path: str | Path) -> Path | None:
     return None
 
 
-def round_mantissa(values: np.ndarray, mantissa_bits: int) -> np.ndarray:
-    """float32 values rounded to nearest (ties to even) with ``mantissa_bits`` of their 23
-    explicit mantissa bits kept: numcodecs' BitRound (Klöwer et al. 2021, "Compressing
-    atmospheric data into its real information content", Nat. Comput. Sci. 1, 713-724).
-
-    The relative error of a normal value is at most 2^-(mantissa_bits + 1) (its RMS over
-    many values about 2^-mantissa_bits / sqrt(12)); zeros stay zero and the sign is kept.
-    The zeroed low bits are what makes the chunk compress."""
-    from numcodecs import BitRound
-
-    a = np.ascontiguousarray(values, dtype=np.float32)
-    return np.asarray(BitRound(keepbits=mantissa_bits).encode(a)).view(np.float32)
-
-
-def write_radiance(root: Path, kind: str, unit: str, light_group: str, cube: np.ndarray,
-                   extent: TanExtent, extra_attrs: dict | None = None, mantissa_bits: int | None = None) -> str:
-    """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`);
-    return the sha256 of the values stored.
-
-    ``mantissa_bits`` (the manifest's ``store.mantissa_bits``; None: lossless) rounds the
-    values first (:func:`round_mantissa`), so the sha256 is that of the rounded values, and
-    records the width in the array's ``mantissa_bits`` attribute."""
-    import zarr
-
-    cube = np.ascontiguousarray(cube, dtype=np.float32)
-    if mantissa_bits is not None:
-        cube = round_mantissa(cube, mantissa_bits)
-    attrs = {
-        "units": RADIANCE_UNITS,
-        "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
-        "extent_tan": list(extent.as_tuple()),
-        "light_group": light_group,
-        **({} if mantissa_bits is None else {"mantissa_bits": mantissa_bits}),
-        **(extra_attrs or {}),
-    }
-    arr = zarr.create_array(
-        store=str(root / RADIANCE_STORE), name=f"{kind}/{unit}/{light_group}", shape=cube.shape,
-        dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
-        compressors=RADIANCE_COMPRESSORS if cube.nbytes <= BLOSC_MAX_BYTES else ZARR_DEFAULT_COMPRESSORS,
-        overwrite=True, config=WRITE_CONFIG,
-    )
-    arr[...] = cube
-    return array_sha256(cube)
-
-
-def write_mask(root: Path, unit: str, mask: np.ndarray, extent: TanExtent) -> str:
-    """Write a scene's instance mask (True = car) over its inset window; return its sha256."""
-    import zarr
-
-    mask = np.ascontiguousarray(mask, dtype=bool)
-    arr = zarr.create_array(
-        store=str(root / RADIANCE_STORE), name=f"masks/{unit}", shape=mask.shape, dtype="bool",
-        chunks=mask.shape, dimension_names=("y", "x"), overwrite=True, config=WRITE_CONFIG,
-        attributes={"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"},
-    )
-    arr[...] = mask
-    return array_sha256(mask)
-
-
 @dataclass(frozen=True)
 class SceneRecord:
     """What the store knows of one scene without reading its radiance."""
@@ -255,11 +173,16 @@ class SceneRecord:
 
 
 class Collection:
-    """A rendered collection, opened read-only. Use :meth:`open`."""
+    """A rendered collection, opened read-only. Use :meth:`open`.
 
-    def __init__(self, root: Path, resolved: dict, groundtruth: dict, groundtruth_sha256: str | None = None):
+    ``manifest`` is the manifest it was rendered from, parsed; ``resolved`` what its making
+    recorded beside it (array hashes, illuminances, the Mitsuba variant: ``manifest.resolved.yaml``)."""
+
+    def __init__(self, root: Path, resolved: ResolvedManifest, manifest: Manifest, groundtruth: dict,
+                 groundtruth_sha256: str | None = None):
         self.root = root
         self.resolved = resolved
+        self.manifest = manifest
         self._groundtruth = groundtruth
         self._groundtruth_sha256 = groundtruth_sha256
         self._images = {img["scene_id"]: img for img in groundtruth["images"]}
@@ -270,7 +193,7 @@ class Collection:
         # The light groups of each plate, inset and frame, as recorded (sorted: float sums
         # are not associative); a recorded array that is absent is an error, not a zero.
         self._recorded: dict[str, list[str]] = {}
-        for path in sorted(resolved["arrays"]):
+        for path in sorted(resolved.arrays):
             parts = path.split("/")
             if len(parts) == 3:
                 self._recorded.setdefault(f"{parts[0]}/{parts[1]}", []).append(parts[2])
@@ -285,7 +208,8 @@ class Collection:
                 raise CollectionError(
                     f"{root}: not a complete collection ({name} is missing; rerun `metricscenes generate` to finish it)"
                 )
-        collection = cls(root, _load_resolved(root), *_load_groundtruth(root))
+        resolved = _load_resolved(root)
+        collection = cls(root, resolved, _parse_manifest(root, resolved), *_load_groundtruth(root))
         problems = collection._groundtruth_problems()
         if problems:
             more = f" (and {len(problems) - 1} more: run `metricscenes verify {root}`)" if len(problems) > 1 else ""
@@ -294,36 +218,40 @@ class Collection:
 
     # --- facts -------------------------------------------------------------------------
     @property
-    def manifest(self) -> dict:
-        return self.resolved["manifest"]
-
-    @property
     def name(self) -> str:
-        return self.manifest["name"]
+        return self.manifest.name
 
     @property
     def protocol(self) -> str:
-        return self.manifest["protocol"]
+        return self.manifest.protocol
 
     @property
     def manifest_sha256(self) -> str:
-        return self.resolved["manifest_sha256"]
+        """As recorded (a manifest parsed from an older collection may gain defaults that
+        would change its hash)."""
+        return self.resolved.manifest_sha256
+
+    @property
+    def render_variant(self) -> str:
+        """The Mitsuba variant that rendered the arrays (collections made before
+        ``render.variant: auto`` record none: their manifest's variant rendered them)."""
+        return self.resolved.render_variant or self.manifest.render.variant
 
     @property
     def conditions(self) -> dict[str, dict[str, float]]:
-        return self.manifest["conditions"]
+        return self.manifest.conditions
 
     @property
     def reference_grid(self) -> tuple[int, int]:
         """(width_px, height_px) of the plates and ground-truth boxes."""
-        g = self.manifest["reference_grid"]
-        return (g["width_px"], g["height_px"])
+        g = self.manifest.reference_grid
+        return (g.width_px, g.height_px)
 
     @property
     def field(self) -> TanExtent:
         """The field of view the plates and the ground-truth grid cover (tangent extent;
         the reference field unless the manifest set ``reference_grid.hfov_deg``)."""
-        return _grid_field(self.manifest)
+        return self.manifest.reference_grid.field
 
     def scenes(self) -> list[SceneRecord]:
         return [
@@ -350,8 +278,8 @@ class Collection:
     @property
     def condition_names(self) -> list[str]:
         """The manifest's conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
-        sweep = self.manifest.get("illuminance_sweep")
-        levels = [illuminance_condition(sweep["base"], lux) for lux in sweep["levels_lux"]] if sweep else []
+        sweep = self.manifest.illuminance_sweep
+        levels = [illuminance_condition(sweep.base, lux) for lux in sweep.levels_lux] if sweep else []
         return list(self.conditions) + levels
 
     def _weights(self, condition: str | dict[str, float], environment_id: int) -> dict[str, float]:
@@ -363,15 +291,15 @@ class Collection:
             )
         if condition in self.conditions:
             return dict(self.conditions[condition])
-        sweep = self.manifest["illuminance_sweep"]
+        sweep = self.manifest.illuminance_sweep
         _, level = parse_illuminance_condition(condition)
-        weights = dict(self.conditions[sweep["base"]])
-        group = sweep["ambient_group"]
-        measured = self.resolved["illuminance_lux"][f"env{environment_id:03d}"].get(group, 0.0)
+        weights = dict(self.conditions[sweep.base])
+        group = sweep.ambient_group
+        measured = self.resolved.illuminance_lux[f"env{environment_id:03d}"].get(group, 0.0)
         if measured <= 0.0:
             raise CollectionError(f"{self.root}: no {group} illuminance recorded for env{environment_id:03d}")
         weights[group] = level / measured
-        for lamp_group in sweep.get("lamps_on", ()):
+        for lamp_group in sweep.lamps_on:
             weights[lamp_group] = 1.0
         return weights
 
@@ -379,7 +307,7 @@ class Collection:
         """Horizontal illuminance at the camera (lux) under a condition: the light groups'
         measured values, weighted (car lamps not included: they face the road)."""
         env = self._image(scene_id)["environment_id"]
-        measured = self.resolved["illuminance_lux"][f"env{env:03d}"]
+        measured = self.resolved.illuminance_lux[f"env{env:03d}"]
         return float(sum(w * measured.get(g, 0.0) for g, w in self._weights(condition, env).items()))
 
     def photometry(self, scene_id: str, condition: str | dict[str, float], f_number: float = 2.4) -> dict:
@@ -405,7 +333,7 @@ class Collection:
     def _read(self, path: str, scene_id: str) -> tuple[np.ndarray, dict]:
         """One array, checked against its recorded sha256 (a one-line error naming the scene)."""
         try:
-            return read_checked(self.root, self._group(), path, self.resolved["arrays"].get(path), f"scene {scene_id}")
+            return read_checked(self.root, self._group(), path, self.resolved.arrays.get(path), f"scene {scene_id}")
         except CollectionError as exc:
             raise CollectionError(f"{self.root}: {exc}; {REPAIR_HINT}") from None
 
@@ -496,8 +424,9 @@ class Collection:
 
 
 def _grid_field(manifest: dict | None) -> TanExtent:
-    """The field a (resolved) manifest's reference grid covers; the reference field where
-    the manifest is absent or predates ``hfov_deg``."""
+    """The field a manifest's reference grid covers, from its JSON form (verify checks
+    collections whose manifest no longer parses); the reference field where the manifest
+    is absent or predates ``hfov_deg``."""
     grid = (manifest or {}).get("reference_grid") or {}
     return field_extent(grid.get("hfov_deg"), grid.get("width_px", 16), grid.get("height_px", 9))
 
@@ -517,24 +446,24 @@ def _box_problem(img: dict, boxes: list, mask: np.ndarray, extent: TanExtent, fi
 
 
 def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha256: str,
-                         resolved: dict | None) -> list[str]:
+                         resolved: ResolvedManifest | None) -> list[str]:
     """The ground truth against its recorded sha256. Where that is absent (collections
     written before it, or an unusable resolved manifest) or differs, every scene is
     checked against the plan and its box recomputed from its mask, so that each problem
     names its scene."""
-    recorded = resolved.get("groundtruth_sha256") if resolved else None
+    recorded = resolved.groundtruth_sha256 if resolved is not None else None
     if recorded is not None and recorded == groundtruth_sha256:
         return []
-    arrays = resolved["arrays"] if resolved else {}
+    arrays = resolved.arrays if resolved is not None else {}
     images = {img["scene_id"]: img for img in groundtruth["images"]}
     boxes: dict[int, list] = {}
     for ann in groundtruth["annotations"]:
         boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
     problems = []
-    field = _grid_field(resolved["manifest"] if resolved else None)
-    if resolved:
-        grid = resolved["manifest"].get("reference_grid", {})
-        plan = {s.get("scene_id"): s for s in resolved.get("plan", []) if isinstance(s, dict)}
+    field = _grid_field(resolved.manifest_json if resolved is not None else None)
+    if resolved is not None:
+        grid = resolved.manifest_json.get("reference_grid", {})
+        plan = {s.get("scene_id"): s for s in resolved.plan if isinstance(s, dict)}
         problems += [f"scene {s}: missing from {GROUNDTRUTH_FILE}" for s in plan if s not in images]
         problems += [f"scene {s}: in {GROUNDTRUTH_FILE} but not in the plan" for s in images if s not in plan]
         for scene_id, img in images.items():
@@ -558,8 +487,9 @@ def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha25
     return problems
 
 
-def _load_resolved(root: Path) -> dict:
-    """The resolved manifest, parsed and checked against its own hashes."""
+def _load_resolved(root: Path) -> ResolvedManifest:
+    """The resolved manifest, parsed and checked against its own hashes (the manifest it
+    holds is parsed by :func:`_parse_manifest`)."""
     try:
         resolved = yaml.safe_load((root / RESOLVED_MANIFEST_FILE).read_text())
     except (OSError, yaml.YAMLError, UnicodeDecodeError) as exc:
@@ -573,7 +503,15 @@ def _load_resolved(root: Path) -> dict:
     content = resolved.get("content_sha256")  # absent in collections written before it
     if content is not None and content != resolved_content_sha256(resolved):
         raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} does not match its content_sha256 (edited or damaged)")
-    return resolved
+    return ResolvedManifest.from_dict(resolved)
+
+
+def _parse_manifest(root: Path, resolved: ResolvedManifest) -> Manifest:
+    """The manifest a collection was rendered from, validated as a manifest file is."""
+    try:
+        return parse_manifest(resolved.manifest_json, source=RESOLVED_MANIFEST_FILE)
+    except ManifestError as exc:
+        raise CollectionError(f"{root}: {exc}") from None
 
 
 def _load_groundtruth(root: Path) -> tuple[dict, str]:
@@ -613,8 +551,6 @@ def verify_collection(path: str | Path) -> list[str]:
     boxes recomputed from the masks). Empty: nothing is wrong."""
     import zarr
 
-    from metricscenes.manifest import ManifestError, parse_manifest
-
     root = Path(path)
     if not root.is_dir():
         return [f"{root}: no such collection folder"]
@@ -622,14 +558,14 @@ def verify_collection(path: str | Path) -> list[str]:
     resolved = groundtruth = None
     try:
         resolved = _load_resolved(root)
-        parse_manifest(resolved["manifest"], source=RESOLVED_MANIFEST_FILE)
-    except (CollectionError, ManifestError) as exc:
+        _parse_manifest(root, resolved)
+    except CollectionError as exc:
         problems.append(str(exc).removeprefix(f"{root}: "))
     try:
         groundtruth = _load_groundtruth(root)
     except CollectionError as exc:
         problems.append(str(exc).removeprefix(f"{root}: "))
-    expected = resolved["arrays"] if resolved is not None else _progress_arrays(root)
+    expected = resolved.arrays if resolved is not None else _progress_arrays(root)
     if not expected:
         problems.append("no recorded array hashes to check (manifest.resolved.yaml and progress/ are unusable)")
     try:

@@ -1,7 +1,7 @@
 """The house's walls, read from the source (issue 12): ``metricscenes`` never imports
 ``benchmark``; ``benchmark`` reaches ``metricscenes`` only through the store API and
-the value and unit modules, never through its render, generate, scene or asset
-internals."""
+the value and unit modules, never through its render, generate, writer, scene or asset
+internals; the store's read side never imports its write side."""
 
 import ast
 from pathlib import Path
@@ -11,7 +11,7 @@ REPO = Path(__file__).resolve().parents[1]
 # What `benchmark` may import from `metricscenes`: the store API (collections, their
 # ground truth on any grid), value types (manifests, tangent extents, spectral scenes), units
 # (wavelength grid, photometry), small shared helpers (files, CLI, the process-pool and
-# dask backends) and the version.
+# dask backends) and the version. Not the writer: benchmark only reads collections.
 PUBLIC = {"metricscenes", "metricscenes.store", "metricscenes.manifest", "metricscenes.geometry", "metricscenes.radiance",
           "metricscenes.spectral", "metricscenes.photometry", "metricscenes.files", "metricscenes.cli_support",
           "metricscenes.backends"}
@@ -41,4 +41,13 @@ def test_metricscenes_never_imports_benchmark():
 def test_benchmark_uses_only_the_public_side_of_metricscenes():
     offenders = {f: sorted(n for n in names if n.split(".")[0] == "metricscenes" and n not in PUBLIC)
                  for f, names in _imports("benchmark").items()}
+    assert {f: n for f, n in offenders.items() if n} == {}
+
+
+def test_the_read_side_never_imports_the_write_side():
+    """``Collection`` (store) and the record types both sides share never reach the
+    writer, nor what drives it."""
+    write_side = {"metricscenes.writer", "metricscenes.generate", "metricscenes.lock"}
+    found = _imports("metricscenes")
+    offenders = {f: sorted(found[f] & write_side) for f in ("metricscenes/store.py", "metricscenes/records.py")}
     assert {f: n for f, n in offenders.items() if n} == {}

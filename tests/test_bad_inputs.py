@@ -217,17 +217,18 @@ def test_cuda_variant_without_a_gpu_fails_before_any_output(tmp_path):
 def test_a_run_that_failed_before_finishing_a_unit_does_not_block_the_corrected_manifest(tmp_path, smoke_manifest):
     """A folder stamped by a run that finished no unit (a render error) is not 'another
     manifest's collection'; one with a finished unit still is."""
-    from metricscenes.generate import _prepare
     from metricscenes.store import CollectionError
+    from metricscenes.writer import CollectionWriter
 
     root = tmp_path / "c"
     (root / "progress").mkdir(parents=True)
     (root / "progress" / "manifest_sha256").write_text("f" * 64 + "\n")
-    _prepare(root, smoke_manifest)
+    variant = smoke_manifest.render.variant
+    CollectionWriter(root).prepare(smoke_manifest, variant)
     assert (root / "progress" / "manifest_sha256").read_text().strip() == smoke_manifest.sha256()
     (root / "progress" / "env000.json").write_text("{}")
     with pytest.raises(CollectionError, match="another manifest"):
-        _prepare(root, smoke_manifest.model_copy(update={"seed": 1}))
+        CollectionWriter(root).prepare(smoke_manifest.model_copy(update={"seed": 1}), variant)
 
 
 # --- the writer's lock -------------------------------------------------------------------

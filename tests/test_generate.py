@@ -195,13 +195,10 @@ def test_photometry_and_illuminance_sweep(smoke_collection):
 def test_illuminance_sweep_keeps_lamps_on(smoke_collection):
     """``lamps_on`` groups join every sweep level at weight 1, the ambient group is scaled."""
     c = Collection.open(smoke_collection)
-    sweep = c.manifest["illuminance_sweep"]
-    c.manifest["illuminance_sweep"] = {**sweep, "lamps_on": ["car_lights", "ego_lights"]}
-    try:
-        weights = c._weights("day@1lux", 0)
-    finally:
-        c.manifest["illuminance_sweep"] = sweep
-    measured = c.resolved["illuminance_lux"]["env000"]["sky_day"]
+    sweep = c.manifest.illuminance_sweep.model_copy(update={"lamps_on": ("car_lights", "ego_lights")})
+    c.manifest = c.manifest.model_copy(update={"illuminance_sweep": sweep})
+    weights = c._weights("day@1lux", 0)
+    measured = c.resolved.illuminance_lux["env000"]["sky_day"]
     assert weights == pytest.approx({"sky_day": 1.0 / measured, "car_lights": 1.0, "ego_lights": 1.0})
 
 
