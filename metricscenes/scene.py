@@ -9,6 +9,7 @@ a weighted sum of the groups' renders).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,14 +72,19 @@ def has_emitters(parts: SceneParts, light_group: str) -> bool:
 def scene_dict(
     env: EnvironmentPlan,
     parts: SceneParts,
-    light_group: str,
+    light_group: str | Sequence[str],
     film: Film,
     *,
     spp: int,
     seed: int,
     max_depth: int,
 ) -> dict:
-    """A ``mi.load_dict``-ready scene lit by ``light_group`` alone."""
+    """A ``mi.load_dict``-ready scene lit by ``light_group`` alone, or by several groups
+    (at most one sky: a scene holds one environment emitter)."""
+    groups = (light_group,) if isinstance(light_group, str) else tuple(light_group)
+    skies_on = [g for g in groups if g in SKY_GROUPS]
+    if len(skies_on) > 1:
+        raise ValueError(f"a scene holds one sky, got {skies_on}")
     scene: dict = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": int(max_depth)},
@@ -91,7 +97,7 @@ def scene_dict(
     import mitsuba as mi
 
     for lamp in parts.lamps:
-        on = lamp.light_group == light_group
+        on = lamp.light_group in groups
         if lamp.shape is not None:
             shape = dict(lamp.shape)
             if on:
@@ -99,8 +105,27 @@ def scene_dict(
             scene[f"lamp_{lamp.name}"] = mi.load_dict(shape)
         elif on:
             scene[f"lamp_{lamp.name}"] = mi.load_dict(lamp.emitter)
-    if light_group in SKY_GROUPS:
-        sky = skies.sky_spec(getattr(env, SKY_GROUPS[light_group]))
+    for group in skies_on:
+        sky = skies.sky_spec(getattr(env, SKY_GROUPS[group]))
         for key, emitter in skies.sky_emitters(sky).items():
             scene[f"sky_{key}"] = emitter
     return scene
+
+
+def emitter_groups(scene_description: dict, loaded_scene, parts: SceneParts, light_groups: Sequence[str]) -> dict:
+    """Each emitter of ``loaded_scene`` (loaded from ``scene_description``, a
+    :func:`scene_dict` of ``light_groups``) → the index of its group in ``light_groups``:
+    a lamp's from the lamp, every other one (the sky, a moon) the pass's sky group."""
+    index = {g: i for i, g in enumerate(light_groups)}
+    groups = {}
+    for lamp in parts.lamps:
+        obj = scene_description.get(f"lamp_{lamp.name}")
+        if lamp.light_group in index and obj is not None:
+            groups[obj.emitter() if lamp.shape is not None else obj] = index[lamp.light_group]
+    sky = [g for g in light_groups if g in SKY_GROUPS]
+    for emitter in loaded_scene.emitters():
+        if emitter not in groups:
+            if not sky:
+                raise ValueError("an emitter that is neither a lamp nor a sky")
+            groups[emitter] = index[sky[0]]
+    return groups

@@ -1,0 +1,225 @@
+"""All light groups of a scene in one path-tracing pass (JIT variants: LLVM and CUDA).
+
+Radiance is linear in emitter power, so the light groups of a unit are usually rendered
+one by one (:mod:`metricscenes.render`): 4–6 full path-tracing passes per unit, and on a
+GPU one kernel compilation per pass. Here each camera path is followed once with every
+lamp of the scene switched on; each emitter contribution (an emitter hit weighted by MIS,
+or a next-event estimate) is added to the accumulator of the group its emitter belongs
+to. The result per group is an unbiased estimate of that group's radiance alone (the
+same estimator as Mitsuba's ``path`` integrator, restricted to one group's emitters), and
+the groups sum to a render with all of them on.
+
+A scene holds one environment emitter, so a pass carries at most one sky group; the
+other groups are lamps (area, spot, point and directional emitters).
+
+Each group is binned into the film's 31 bands by the film itself
+(``Film.prepare_sample``, as ``specfilm`` does for ``mi.render``) and splatted into its
+own image block with the same box filter, so a group's image is band-for-band what a
+``specfilm`` would develop.
+
+Only JIT variants trace a Python integrator at native speed (scalar variants would call
+it once per sample); :func:`render_light_groups` refuses scalar ones.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from metricscenes.render import RenderError
+from metricscenes.spectral import WAVELENGTHS_NM
+
+
+def _mis_weight(pdf_a, pdf_b):
+    """Power heuristic (β = 2), as Mitsuba's path integrator."""
+    import drjit as dr
+
+    a2 = pdf_a * pdf_a
+    w = a2 / (a2 + pdf_b * pdf_b)
+    return dr.detach(dr.select(dr.isfinite(w), w, 0))
+
+
+class _Groups:
+    """The scene's emitters by group, in the forms the traced kernel reads: per group an
+    ``EmitterPtr`` array to sample from, and lookups from an emitter pointer's registry
+    index to its group and to its selection probability within the group."""
+
+    def __init__(self, emitter_groups: Mapping[object, int], n_groups: int):
+        import drjit as dr
+        import mitsuba as mi
+
+        members: list[list] = [[] for _ in range(n_groups)]
+        for emitter, group in emitter_groups.items():
+            members[group].append(emitter)
+        index = {e: int(dr.reinterpret_array(mi.UInt32, mi.EmitterPtr(e))[0]) for e in emitter_groups}
+        size = max(index.values(), default=0) + 1
+        group_of = np.full(size, n_groups, dtype=np.uint32)  # n_groups: an emitter of no group
+        pmf = np.zeros(size, dtype=np.float32)
+        for group, emitters in enumerate(members):
+            for e in emitters:
+                group_of[index[e]], pmf[index[e]] = group, 1.0 / len(emitters)
+        self.members = [mi.EmitterPtr(emitters) if emitters else None for emitters in members]
+        self.counts = [len(emitters) for emitters in members]
+        self.group_table, self.pmf_table = mi.UInt32(group_of), mi.Float(pmf)
+
+    def lookup(self, emitter):
+        """(group index, selection probability within the group) of emitter pointers."""
+        import drjit as dr
+        import mitsuba as mi
+
+        index = dr.minimum(dr.reinterpret_array(mi.UInt32, emitter), dr.width(self.group_table) - 1)
+        return dr.gather(mi.UInt32, self.group_table, index), dr.gather(mi.Float, self.pmf_table, index)
+
+
+def _sample_group_emitter(scene, groups: _Groups, group: int, si, sample, active):
+    """Next-event estimation restricted to one group: an emitter of the group chosen
+    uniformly (as a scene holding only that group's emitters would), a direction on it,
+    and a shadow ray. Returns the direction sample (pdf including the choice) and the
+    emitted radiance divided by that pdf, zero where occluded."""
+    import drjit as dr
+    import mitsuba as mi
+
+    count = groups.counts[group]
+    choice = dr.minimum(mi.UInt32(sample.x * count), count - 1)
+    sample = mi.Point2f(sample.x * count - mi.Float(choice), sample.y)
+    emitter = dr.gather(mi.EmitterPtr, groups.members[group], choice, active)
+    ds, weight = emitter.sample_direction(si, sample, active)
+    active &= ds.pdf != 0.0
+    occluded = scene.ray_test(si.spawn_ray_to(ds.p), active)
+    ds.pdf *= 1.0 / count
+    return ds, dr.select(active & ~occluded, weight * count, 0), active & ~occluded
+
+
+def _trace(scene, sampler, ray, groups: _Groups, max_depth: int, rr_depth: int = 5):
+    """Per-group radiance along ``ray``: a list of spectra, one per group (unidirectional
+    path tracing with next-event estimation and MIS, the structure of Mitsuba's ``path``;
+    next-event estimation once per group and vertex, so that each group is sampled as in
+    a render of that group alone)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    bsdf_ctx = mi.BSDFContext()
+    n_groups = len(groups.counts)
+
+    def body(sampler, ray, depth, beta, eta, active, si_prev, pdf_prev, delta_prev, sums):
+        si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
+        bsdf = si.bsdf(ray)
+
+        # An emitter hit (or the environment when the ray escapes), weighted against the
+        # next-event estimate of its own group.
+        ds = mi.DirectionSample3f(scene, si=si, ref=si_prev)
+        hit_group, hit_pmf = groups.lookup(ds.emitter)
+        pdf_nee = dr.select(delta_prev, 0, ds.emitter.pdf_direction(si_prev, ds, active & ~delta_prev) * hit_pmf)
+        emitted = beta * _mis_weight(pdf_prev, pdf_nee) * ds.emitter.eval(si, active)
+        hit = active & (ds.emitter != None)  # noqa: E711
+        sums = [s + dr.select(hit & (hit_group == g), emitted, 0) for g, s in enumerate(sums)]
+
+        active_next = active & (depth + 1 < max_depth) & si.is_valid()
+        smooth = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
+        for g in range(n_groups):
+            if not groups.counts[g]:
+                continue
+            ds_g, em_weight, visible = _sample_group_emitter(scene, groups, g, si, sampler.next_2d(), smooth)
+            bsdf_value, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, si.to_local(ds_g.d), visible)
+            mis = dr.select(ds_g.delta, 1, _mis_weight(ds_g.pdf, bsdf_pdf))
+            sums[g] = sums[g] + dr.select(visible, beta * mis * bsdf_value * em_weight, 0)
+
+        bsdf_sample, bsdf_weight = bsdf.sample(bsdf_ctx, si, sampler.next_1d(), sampler.next_2d(), active_next)
+        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
+        eta *= bsdf_sample.eta
+        beta *= bsdf_weight
+        beta_max = dr.max(mi.unpolarized_spectrum(beta))
+        active_next &= beta_max != 0
+        rr_prob = dr.minimum(beta_max * eta * eta, 0.95)
+        rr_active = depth >= rr_depth
+        beta[rr_active] *= dr.rcp(rr_prob)
+        active_next &= ~rr_active | (sampler.next_1d() < rr_prob)
+        return (sampler, ray, depth + 1, beta, eta, active_next, dr.detach(si, True), bsdf_sample.pdf,
+                mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta), sums)
+
+    # The sampler is loop state: its random number generator must advance per bounce.
+    state = (sampler, mi.Ray3f(ray), mi.UInt32(0), mi.Spectrum(1), mi.Float(1), mi.Bool(True),
+             dr.zeros(mi.SurfaceInteraction3f), mi.Float(1), mi.Bool(True),
+             [mi.Spectrum(0) for _ in range(n_groups)])
+    state = dr.while_loop(state, lambda *s: s[5], body, labels=(
+        "sampler", "ray", "depth", "beta", "eta", "active", "si_prev", "pdf_prev", "delta_prev", "sums"),
+        label="light groups")
+    return state[-1]
+
+
+def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: int, *, spp: int, seed: int,
+                        max_depth: int) -> list[np.ndarray]:
+    """Render a loaded scene (a ``specfilm`` sensor with a ``box`` filter, every group's
+    emitters on) once and return one (rows, cols, 31) float32 radiance cube per group.
+
+    ``emitter_groups`` maps each emitter object of the scene (lamps' emitters, the
+    environment, a directional moon) to its group index in ``range(n_groups)``.
+    """
+    import drjit as dr
+    import mitsuba as mi
+    from mitsuba.ad.integrators.common import ADIntegrator
+
+    if not mi.variant().startswith(("llvm", "cuda")):
+        raise RenderError(f"one-pass light groups need a JIT variant (llvm_ad_spectral, cuda_ad_spectral), "
+                          f"not {mi.variant()}")
+    missing = [e for e in scene.emitters() if e not in emitter_groups]
+    if missing:
+        raise RenderError(f"{len(missing)} emitter(s) of the scene belong to no light group")
+    sensor = scene.sensors()[0]
+    film = sensor.film()
+    helper = ADIntegrator(mi.Properties())
+    with dr.suspend_grad():
+        sampler, spp = helper.prepare(sensor, seed=seed, spp=spp)
+        ray, weight, pos = helper.sample_rays(scene, sensor, sampler)
+        sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
+        blocks = []
+        for radiance in sums:
+            block = film.create_block()
+            block.set_coalesce(block.coalesce() and spp >= 4)
+            block.put(pos, film.prepare_sample(radiance * weight, ray.wavelengths, block.channel_count(),
+                                               weight=1.0, alpha=1.0))
+            blocks.append(block.tensor())
+        dr.eval(blocks)
+    images = []
+    for tensor in blocks:
+        raw = np.array(tensor, dtype=np.float32)
+        bands, w = raw[..., : WAVELENGTHS_NM.size], raw[..., -1:]
+        images.append(bands / np.where(w == 0, 1, w))
+    return images
+
+
+def passes(light_groups: Sequence[str]) -> list[tuple[str, ...]]:
+    """How a JIT variant renders ``light_groups`` on one film: the first sky with every
+    lamp group in one pass, each other sky alone (a scene holds one environment)."""
+    from metricscenes.scene import SKY_GROUPS
+
+    skies = [g for g in light_groups if g in SKY_GROUPS]
+    lamps = [g for g in light_groups if g not in SKY_GROUPS]
+    first = tuple(skies[:1] + lamps)
+    return ([first] if first else []) + [(sky,) for sky in skies[1:]]
+
+
+def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed: int,
+                max_depth: int) -> dict[str, np.ndarray]:
+    """Radiance (rows, cols, 31) of each of ``light_groups`` on ``film`` from one render of
+    the scene with all of them on (a single group: Mitsuba's ``path``, as per group)."""
+    import mitsuba as mi
+
+    from metricscenes import scene as scene_mod
+    from metricscenes.render import render_radiance
+
+    description = scene_mod.scene_dict(env, parts, light_groups, film, spp=spp, seed=seed, max_depth=max_depth)
+    if len(light_groups) == 1:
+        return {light_groups[0]: render_radiance(description, spp)}
+    try:
+        scene = mi.load_dict(description)
+    except Exception as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise RenderError(f"scene load failed: {first}") from exc
+    groups = scene_mod.emitter_groups(description, scene, parts, light_groups)
+    images = render_light_groups(scene, groups, len(light_groups), spp=spp, seed=seed, max_depth=max_depth)
+    for image in images:
+        if not np.all(np.isfinite(image)):
+            raise RenderError("render produced non-finite radiance")
+    return dict(zip(light_groups, images))
