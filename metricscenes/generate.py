@@ -85,7 +85,8 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     (the manifest's, ``auto`` resolved); return its progress record (the caller writes it)."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
-    from metricscenes.render import Film, illuminance_meter, render_radiance, use_variant
+    from metricscenes.lightgroups import render_pass
+    from metricscenes.render import Film, illuminance_meter, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
     use_variant(variant, threads)
@@ -117,19 +118,37 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
             # reach the camera): that group also gets a whole frame at plate sampling.
             jobs.append(("frames", "car_lights", Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field))
     illuminance = {}
-    for i, (kind, group, film, spp, extent) in enumerate(jobs):
-        if not scene_mod.has_emitters(parts, group):
-            continue
-        sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
-                                  max_depth=manifest.render.max_depth)
-        arrays.write_radiance(kind, group, render_radiance(sd, spp), extent, {"spp": spp, "seed": unit.seed})
-        if unit.kind == PLATE:
-            irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)
-            illuminance[group] = round(float(radiance_to_xyz(irradiance)[1]), 9)
+    lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
+    for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=variant.startswith(("llvm", "cuda"))):
+        images = render_pass(env, parts, groups, film, spp=spp, seed=unit.seed + 7919 * seeds[0],
+                             max_depth=manifest.render.max_depth)
+        for i, group in zip(seeds, groups):
+            arrays.write_radiance(kind, group, images[group], extent, {"spp": spp, "seed": unit.seed})
+            if unit.kind == PLATE:
+                sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
+                                          max_depth=manifest.render.max_depth)
+                irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)
+                illuminance[group] = round(float(radiance_to_xyz(irradiance)[1]), 9)
     return UnitRecord(unit=unit.key, kind=unit.kind, arrays=arrays.sha256,
                       seconds=round(time.perf_counter() - started, 3),
                       illuminance_lux=illuminance or None,  # (a plate no group lights records none)
                       inset=inset)
+
+
+def _renders(lit_jobs: list, one_pass: bool) -> list:
+    """The renders of a unit's lit jobs ``(index, (kind, group, film, spp, extent))``, as
+    (job indices, (kind, film, spp, extent), groups): one per job, or on a JIT variant one
+    per pass of :func:`metricscenes.lightgroups.passes` over the jobs sharing a film. A
+    render's seed comes from its first job's index (one job each: the seeds of old)."""
+    from metricscenes.lightgroups import passes
+
+    if not one_pass:
+        return [((i, ), (kind, film, spp, extent), (group, )) for i, (kind, group, film, spp, extent) in lit_jobs]
+    by_film: dict = {}
+    for i, (kind, group, film, spp, extent) in lit_jobs:
+        by_film.setdefault((kind, film, spp, extent), {})[group] = i
+    return [(tuple(index[g] for g in groups), target, groups)
+            for target, index in by_film.items() for groups in passes(list(index))]
 
 
 def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray):

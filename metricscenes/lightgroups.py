@@ -13,9 +13,9 @@ A scene holds one environment emitter, so a pass carries at most one sky group; 
 other groups are lamps (area, spot, point and directional emitters).
 
 Each group is binned into the film's 31 bands by the film itself
-(``Film.prepare_sample``, as ``specfilm`` does for ``mi.render``) and splatted into its
-own image block with the same box filter, so a group's image is band-for-band what a
-``specfilm`` would develop.
+(``Film.prepare_sample``, as ``specfilm`` does for ``mi.render``) and averaged per pixel
+(the ``box`` filter's develop) by a block sum in a fixed order, so a group's image is
+band-for-band what a ``specfilm`` would develop, and the same bits on every run.
 
 Only JIT variants trace a Python integrator at native speed (scalar variants would call
 it once per sample); :func:`render_light_groups` refuses scalar ones.
@@ -171,21 +171,23 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
     helper = ADIntegrator(mi.Properties())
     with dr.suspend_grad():
         sampler, spp = helper.prepare(sensor, seed=seed, spp=spp)
-        ray, weight, pos = helper.sample_rays(scene, sensor, sampler)
+        ray, weight, _ = helper.sample_rays(scene, sensor, sampler)
         sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
-        blocks = []
+        # One kernel traces the paths; the reductions below read its stored results (left
+        # lazy, each band of each group would re-trace every path in its own kernel).
+        dr.eval(sums, ray.wavelengths, weight)
+        bands = WAVELENGTHS_NM.size
+        per_group = []
         for radiance in sums:
-            block = film.create_block()
-            block.set_coalesce(block.coalesce() and spp >= 4)
-            block.put(pos, film.prepare_sample(radiance * weight, ray.wavelengths, block.channel_count(),
-                                               weight=1.0, alpha=1.0))
-            blocks.append(block.tensor())
-        dr.eval(blocks)
-    images = []
-    for tensor in blocks:
-        raw = np.array(tensor, dtype=np.float32)
-        bands, w = raw[..., : WAVELENGTHS_NM.size], raw[..., -1:]
-        images.append(bands / np.where(w == 0, 1, w))
+            # The film bins a sample into its bands (and a unit weight); a pixel's samples
+            # are consecutive lanes (sample_rays), so their mean is a block sum in a fixed
+            # order: no atomic adds, the same bits on every run and thread count.
+            channels = film.prepare_sample(radiance * weight, ray.wavelengths, bands + 1, weight=1.0, alpha=1.0)
+            per_group.append([dr.block_sum(c, spp) / spp for c in channels[:bands]])
+        dr.eval(per_group)
+    cols, rows = film.crop_size()
+    images = [np.stack([np.asarray(c, dtype=np.float32) for c in group], axis=-1).reshape(rows, cols, bands)
+              for group in per_group]
     return images
 
 
@@ -203,14 +205,18 @@ def passes(light_groups: Sequence[str]) -> list[tuple[str, ...]]:
 def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed: int,
                 max_depth: int) -> dict[str, np.ndarray]:
     """Radiance (rows, cols, 31) of each of ``light_groups`` on ``film`` from one render of
-    the scene with all of them on (a single group: Mitsuba's ``path``, as per group)."""
+    the scene with all of them on: on a JIT variant by :func:`render_light_groups` (one
+    group too: the same bits on every run), on a scalar one (one group only) by Mitsuba's
+    ``path``."""
     import mitsuba as mi
 
     from metricscenes import scene as scene_mod
     from metricscenes.render import render_radiance
 
     description = scene_mod.scene_dict(env, parts, light_groups, film, spp=spp, seed=seed, max_depth=max_depth)
-    if len(light_groups) == 1:
+    if not mi.variant().startswith(("llvm", "cuda")):
+        if len(light_groups) != 1:
+            raise RenderError(f"one-pass light groups need a JIT variant, not {mi.variant()}")
         return {light_groups[0]: render_radiance(description, spp)}
     try:
         scene = mi.load_dict(description)

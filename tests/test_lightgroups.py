@@ -63,6 +63,8 @@ def _measure(seed: int = 11) -> dict:
 
     out = {g: compare([o[g] for o in one], [a[g] for a in alone]) for g in GROUPS}
     out["all"] = compare(one_sum, all_on)
+    again = render_pass(env, parts, GROUPS, film, spp=SPP, seed=seed, max_depth=depth)
+    out["same_bits"] = all(np.array_equal(again[g], one[0][g]) for g in GROUPS)
     return out
 
 
@@ -81,6 +83,7 @@ def test_one_pass_light_groups_agree_with_one_render_per_group():
     proc = subprocess.run([sys.executable, __file__], capture_output=True, text=True, timeout=1200, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr[-2000:]
     stats = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert stats.pop("same_bits"), "a second render with the same seed differs"
     for name, s in stats.items():
         assert s["mean"] > 0, name
         assert abs(s["t"]) < 4.5, (name, s)
