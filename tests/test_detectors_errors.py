@@ -160,3 +160,22 @@ def test_static_model_native_warns(tmp_path):
     with pytest.warns(UserWarning, match="falls back to 64"):
         det = load_detector(model, input_size="native")
     assert [p.size_px for p in det.passes] == [64]
+
+
+def test_a_detector_reopened_in_another_process_checks_its_file(tmp_path):
+    """What a sweep worker does with a pickled detector: the same file loads again with the
+    same settings; a file changed since the first load is refused in one line."""
+    import shutil
+
+    from benchmark.detectors.loader import reopen_detector
+
+    model = tmp_path / "yolov5n.onnx"
+    shutil.copyfile(MODEL_DIR / "yolov5n.onnx", model)
+    first = load_detector(model, threads=1)
+    again = reopen_detector(model, first.name, first.family, first.sha256, first.input_size, None, 1)
+    assert (again.name, again.family, again.sha256) == (first.name, first.family, first.sha256)
+    with model.open("ab") as f:
+        f.write(b"\0")
+    reopen_detector.cache_clear()
+    with pytest.raises(DetectorError, match="the model file changed"):
+        reopen_detector(model, first.name, first.family, first.sha256, first.input_size, None, 1)

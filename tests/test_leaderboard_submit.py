@@ -319,3 +319,10 @@ def test_committed_reference_submissions_are_valid_and_rendered():
     submissions = load_submissions(folder, protocols)
     assert render_markdown(submissions, protocols) == (folder / "README.md").read_text()
     assert render_html(submissions, protocols) == (folder / "index.html").read_text()
+
+
+def test_tree_hash_of_a_missing_folder_is_empty(tmp_path):
+    assert tree_sha256(tmp_path / "absent") == {}
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "x.json").write_text("{}")
+    assert list(tree_sha256(tmp_path)) == ["a/x.json"]

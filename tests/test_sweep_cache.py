@@ -233,3 +233,20 @@ def test_json_is_strict(tmp_path, monkeypatch):
     assert json_safe([np.float64("nan"), np.inf, np.int64(2)]) == [None, "inf", 2]
     make_fake_sweep(tmp_path / "sw", monkeypatch)
     json.loads((tmp_path / "sw" / "sweep.json").read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))
+
+
+def test_mtf_policy_falls_through_sources_that_give_nothing(monkeypatch):
+    """A camera the edge bench cannot image falls through to the analytic figure; one that no
+    source can give reports (None, "none")."""
+    from benchmark.measure import mtf as mtf_module
+
+    cam = load_camera("cam05")
+
+    def cannot_image(camera):
+        raise ValueError("edge outside the sensor")
+
+    monkeypatch.setattr(mtf_module, "measure_mtf50", cannot_image)
+    value, source = mtf_module.camera_mtf50(cam)
+    assert source == "analytic" and value == mtf_module.camera_mtf50(cam, "analytic")[0]
+    monkeypatch.setattr(mtf_module, "mtf50_analytic_cy_per_mm", lambda *a, **k: float("nan"))
+    assert mtf_module.camera_mtf50(cam.model_copy(update={"mtf50_group_cy_per_mm": None})) == (None, "none")
