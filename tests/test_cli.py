@@ -77,7 +77,8 @@ def test_llvm_variant_never_aborts_the_process(tmp_path):
     import yaml
 
     data = yaml.safe_load(SMOKE_MANIFEST.read_text())
-    data.update(environments=1, distances_m=[25])
+    data.update(environments=1, distances_m=[25], light_groups=["sky_day"], conditions={"day": {"sky_day": 1.0}})
+    data.pop("illuminance_sweep")
     data["render"]["variant"] = "llvm_ad_spectral"
     manifest = tmp_path / "llvm.yaml"
     manifest.write_text(yaml.safe_dump(data))
