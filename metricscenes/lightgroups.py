@@ -24,6 +24,7 @@ it once per sample); :func:`render_light_groups` refuses scalar ones.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -148,17 +149,37 @@ def _trace(scene, sampler, ray, groups: _Groups, max_depth: int, rr_depth: int =
     return state[-1]
 
 
+def _window_rays(sensor, sampler, window: tuple[int, int, int, int], spp: int):
+    """Camera rays through the pixels of ``window`` (x, y, cols, rows of the sensor's whole
+    film), ``spp`` per pixel, consecutive per pixel, and their weights: what Mitsuba's
+    ``sample_rays`` does for a film cropped to the window, with the window's numbers opaque
+    so that one compiled kernel serves every window of a film (every inset of a unit and
+    of the environments that share the inset scale)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    x0, y0, cols, _ = window
+    width, height = sensor.film().size()
+    idx = dr.arange(mi.UInt32, dr.prod(window[2:]) * spp) // dr.opaque(mi.UInt32, spp)
+    row = idx // dr.opaque(mi.UInt32, cols)
+    pixel = mi.Vector2u(idx - row * dr.opaque(mi.UInt32, cols), row) + mi.Vector2u(dr.opaque(mi.UInt32, x0),
+                                                                               dr.opaque(mi.UInt32, y0))
+    position = (mi.Vector2f(pixel) + sampler.next_2d()) / mi.ScalarVector2f(width, height)
+    return sensor.sample_ray_differential(time=sensor.shutter_open(), sample1=sampler.next_1d(),
+                                          sample2=position, sample3=mi.Vector2f(0.5))
+
+
 def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: int, *, spp: int, seed: int,
-                        max_depth: int) -> list[np.ndarray]:
+                        max_depth: int, window: tuple[int, int, int, int] | None = None) -> list[np.ndarray]:
     """Render a loaded scene (a ``specfilm`` sensor with a ``box`` filter, every group's
-    emitters on) once and return one (rows, cols, 31) float32 radiance cube per group.
+    emitters on) once and return one (rows, cols, 31) float32 radiance cube per group, of
+    ``window`` (x, y, cols, rows on the sensor's film; default the whole film).
 
     ``emitter_groups`` maps each emitter object of the scene (lamps' emitters, the
     environment, a directional moon) to its group index in ``range(n_groups)``.
     """
     import drjit as dr
     import mitsuba as mi
-    from mitsuba.ad.integrators.common import ADIntegrator
 
     if not mi.variant().startswith(("llvm", "cuda")):
         raise RenderError(f"one-pass light groups need a JIT variant (llvm_ad_spectral, cuda_ad_spectral), "
@@ -168,10 +189,14 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
         raise RenderError(f"{len(missing)} emitter(s) of the scene belong to no light group")
     sensor = scene.sensors()[0]
     film = sensor.film()
-    helper = ADIntegrator(mi.Properties())
+    window = window or (0, 0, *film.size())
     with dr.suspend_grad():
-        sampler, spp = helper.prepare(sensor, seed=seed, spp=spp)
-        ray, weight, _ = helper.sample_rays(scene, sensor, sampler)
+        film.prepare([])  # (its channels: the bands and a weight)
+        sampler = sensor.sampler().fork()
+        sampler.set_sample_count(spp)
+        sampler.set_samples_per_wavefront(spp)
+        sampler.seed(seed, window[2] * window[3] * spp)
+        ray, weight = _window_rays(sensor, sampler, window, spp)
         sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
         # One kernel traces the paths; the reductions below read its stored results (left
         # lazy, each band of each group would re-trace every path in its own kernel).
@@ -180,12 +205,12 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
         per_group = []
         for radiance in sums:
             # The film bins a sample into its bands (and a unit weight); a pixel's samples
-            # are consecutive lanes (sample_rays), so their mean is a block sum in a fixed
-            # order: no atomic adds, the same bits on every run and thread count.
+            # are consecutive lanes, so their mean is a block sum in a fixed order: no
+            # atomic adds, the same bits on every run and thread count.
             channels = film.prepare_sample(radiance * weight, ray.wavelengths, bands + 1, weight=1.0, alpha=1.0)
             per_group.append([dr.block_sum(c, spp) / spp for c in channels[:bands]])
         dr.eval(per_group)
-    cols, rows = film.crop_size()
+    cols, rows = window[2:]
     images = [np.stack([np.asarray(c, dtype=np.float32) for c in group], axis=-1).reshape(rows, cols, bands)
               for group in per_group]
     return images
@@ -213,18 +238,23 @@ def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed
     from metricscenes import scene as scene_mod
     from metricscenes.render import render_radiance
 
-    description = scene_mod.scene_dict(env, parts, light_groups, film, spp=spp, seed=seed, max_depth=max_depth)
     if not mi.variant().startswith(("llvm", "cuda")):
         if len(light_groups) != 1:
             raise RenderError(f"one-pass light groups need a JIT variant, not {mi.variant()}")
+        description = scene_mod.scene_dict(env, parts, light_groups, film, spp=spp, seed=seed, max_depth=max_depth)
         return {light_groups[0]: render_radiance(description, spp)}
+    # The scene's film is the whole film (the same for every window of it) and the crop is
+    # the window: the kernel does not change with the window.
+    whole = replace(film, crop_x=0, crop_y=0, crop_width=None, crop_height=None)
+    description = scene_mod.scene_dict(env, parts, light_groups, whole, spp=spp, seed=seed, max_depth=max_depth)
     try:
         scene = mi.load_dict(description)
     except Exception as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise RenderError(f"scene load failed: {first}") from exc
     groups = scene_mod.emitter_groups(description, scene, parts, light_groups)
-    images = render_light_groups(scene, groups, len(light_groups), spp=spp, seed=seed, max_depth=max_depth)
+    images = render_light_groups(scene, groups, len(light_groups), spp=spp, seed=seed, max_depth=max_depth,
+                                 window=(film.crop_x, film.crop_y, *film.size))
     for image in images:
         if not np.all(np.isfinite(image)):
             raise RenderError("render produced non-finite radiance")
