@@ -5,7 +5,9 @@ once per group (Mitsuba's ``path``, as scalar variants do) and in the passes of
 :func:`metricscenes.lightgroups.passes` (the first sky with every lamp group, other
 skies alone), each twice with different seeds: the first render of a kind pays the
 kernel compilation (JIT variants), the second shows the render itself. Prints both and
-their ratios (a baseline in the same run: these machines are noisy).
+their ratios (a baseline in the same run: these machines are noisy); then the one pass at
+50 and 100 m, whose windows differ: with the window's numbers opaque, a new window costs a
+render, not a compilation.
 
     python benchmarks/bench_light_groups.py [manifests/quick.yaml] [--variant llvm_ad_spectral]
         [--distance 25]
@@ -67,6 +69,17 @@ def main() -> None:
         print(f"{name:10s}: first {first:7.1f} s (with compilation), second {second:6.1f} s")
     (f1, s1), (f2, s2) = times["per group"], times["one pass"]
     print(f"ratio per group / one pass: first {f1 / f2:.2f}x, second {s1 / s2:.2f}x")
+    # A new window (another distance, another inset scale) keeps the one pass's kernels.
+    for distance in (50.0, 100.0):
+        other = scene_mod.car_pose(env, distance)
+        other_parts = scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, other))
+        k2, x2, y2, w2, h2 = inset_window(car_box_tan(scene_mod.car_vertices(env, other)), m)
+        other_film = Film(grid.width_px * k2, grid.height_px * k2, x2, y2, w2, h2, field=grid.field)
+        t = time.perf_counter()
+        for i, pass_groups in enumerate(passes(groups)):
+            render_pass(env, other_parts, pass_groups, other_film, spp=spp, seed=201 + i, max_depth=depth)
+        print(f"one pass at {distance:g} m (first render of a new window, {w2} x {h2} px, scale {k2}): "
+              f"{time.perf_counter() - t:.1f} s")
     samples = cw * ch * spp * len(groups)
     print(f"samples per group and pixel, all groups: {samples / 1e6:.1f} M; "
           f"one pass {samples / s2 / 1e6:.2f} M group-samples/s, per group {samples / s1 / 1e6:.2f} M/s")

@@ -153,8 +153,8 @@ def _window_rays(sensor, sampler, window: tuple[int, int, int, int], spp: int):
     """Camera rays through the pixels of ``window`` (x, y, cols, rows of the sensor's whole
     film), ``spp`` per pixel, consecutive per pixel, and their weights: what Mitsuba's
     ``sample_rays`` does for a film cropped to the window, with the window's numbers opaque
-    so that one compiled kernel serves every window of a film (every inset of a unit and
-    of the environments that share the inset scale)."""
+    so that one compiled kernel serves every window of every film of the same field and
+    aspect ratio (every inset of every environment, whatever its scale)."""
     import drjit as dr
     import mitsuba as mi
 
@@ -164,9 +164,13 @@ def _window_rays(sensor, sampler, window: tuple[int, int, int, int], spp: int):
     row = idx // dr.opaque(mi.UInt32, cols)
     pixel = mi.Vector2u(idx - row * dr.opaque(mi.UInt32, cols), row) + mi.Vector2u(dr.opaque(mi.UInt32, x0),
                                                                                dr.opaque(mi.UInt32, y0))
-    position = (mi.Vector2f(pixel) + sampler.next_2d()) / mi.ScalarVector2f(width, height)
-    return sensor.sample_ray_differential(time=sensor.shutter_open(), sample1=sampler.next_1d(),
-                                          sample2=position, sample3=mi.Vector2f(0.5))
+    size = mi.Vector2f(dr.opaque(mi.Float, width), dr.opaque(mi.Float, height))
+    position = (mi.Vector2f(pixel) + sampler.next_2d()) / size
+    # No ray differentials: their pixel footprint would make the film's size part of the kernel
+    # (the projection itself depends on the field and the aspect ratio, the same for every
+    # inset scale). Nothing in the scenes filters textures by footprint.
+    return sensor.sample_ray(time=sensor.shutter_open(), sample1=sampler.next_1d(), sample2=position,
+                             sample3=mi.Vector2f(0.5))
 
 
 def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: int, *, spp: int, seed: int,
@@ -195,7 +199,7 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
         sampler = sensor.sampler().fork()
         sampler.set_sample_count(spp)
         sampler.set_samples_per_wavefront(spp)
-        sampler.seed(seed, window[2] * window[3] * spp)
+        sampler.seed(dr.opaque(mi.UInt32, seed), window[2] * window[3] * spp)  # (a literal seed: a kernel per seed)
         ray, weight = _window_rays(sensor, sampler, window, spp)
         sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
         # One kernel traces the paths; the reductions below read its stored results (left
