@@ -10,7 +10,7 @@ same estimator as Mitsuba's ``path`` integrator, restricted to one group's emitt
 the groups sum to a render with all of them on.
 
 A scene holds one environment emitter, so a pass carries at most one sky group; the
-other groups are lamps (area, spot, point and directional emitters).
+other groups are lamps (area, spot and point emitters; a moon goes with its sky).
 
 Each group is binned into the film's 31 bands by the film itself
 (``Film.prepare_sample``, as ``specfilm`` does for ``mi.render``) and averaged per pixel
