@@ -169,13 +169,21 @@ def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray):
 def _instance_mask(manifest: Manifest, unit: Unit, env_parts, parts, film, extent):
     """The car's instance mask over the inset (the rays whose first hit moves when the car
     is added) and its tight box in tangent coordinates."""
+    import mitsuba as mi
+
     from metricscenes import scene as scene_mod
+    from metricscenes.lightgroups import depth_pass
     from metricscenes.render import RenderError, render_depth
 
     group = manifest.light_groups[0]
-    depth_with, depth_without = (
-        render_depth(scene_mod.scene_dict(unit.environment, p, group, film, spp=1, seed=unit.seed, max_depth=2), film)
-        for p in (parts, env_parts))
+    if mi.variant().startswith(("llvm", "cuda")):  # one kernel for every inset
+        depth_with, depth_without = (depth_pass(unit.environment, p, group, film, seed=unit.seed)
+                                     for p in (parts, env_parts))
+    else:
+        depth_with, depth_without = (
+            render_depth(scene_mod.scene_dict(unit.environment, p, group, film, spp=1, seed=unit.seed, max_depth=2),
+                         film)
+            for p in (parts, env_parts))
     mask = (depth_with > 0) & (depth_with != depth_without)
     mask_box = mask_box_tan(mask, extent)
     if mask_box is None:

@@ -263,3 +263,31 @@ def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed
         if not np.all(np.isfinite(image)):
             raise RenderError("render produced non-finite radiance")
     return dict(zip(light_groups, images))
+
+
+def depth_pass(env, parts, light_group: str, film, *, seed: int) -> np.ndarray:
+    """Distance (m) along each pixel's ray to the first surface, 0 where it escapes: one ray
+    per pixel of ``film``'s crop at positions fixed by ``seed`` (two scenes are probed along
+    the same rays), traced like :func:`render_pass`'s rays, so that on a JIT variant one
+    kernel serves every inset (``render.render_depth`` compiles one per crop)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    from metricscenes import scene as scene_mod
+
+    whole = replace(film, crop_x=0, crop_y=0, crop_width=None, crop_height=None)
+    try:
+        scene = mi.load_dict(scene_mod.scene_dict(env, parts, light_group, whole, spp=1, seed=seed, max_depth=2))
+    except Exception as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise RenderError(f"scene load failed: {first}") from exc
+    sensor = scene.sensors()[0]
+    cols, rows = film.size
+    sampler = sensor.sampler().fork()
+    sampler.set_sample_count(1)
+    sampler.set_samples_per_wavefront(1)
+    sampler.seed(dr.opaque(mi.UInt32, seed), cols * rows)
+    ray, _ = _window_rays(sensor, sampler, (film.crop_x, film.crop_y, cols, rows), 1)
+    hit = scene.ray_intersect(ray)
+    distance = dr.select(hit.is_valid(), hit.t, 0.0)
+    return np.asarray(distance, dtype=np.float32).reshape(rows, cols)
