@@ -167,7 +167,7 @@ def test_a_detector_reopened_in_another_process_checks_its_file(tmp_path):
     same settings; a file changed since the first load is refused in one line."""
     import shutil
 
-    from benchmark.detectors.loader import reopen_detector
+    from benchmark.detectors.onnx_detector import reopen_detector
 
     model = tmp_path / "yolov5n.onnx"
     shutil.copyfile(MODEL_DIR / "yolov5n.onnx", model)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from functools import lru_cache
 from pathlib import Path
 
 from benchmark.detectors.base import DetectorError
@@ -11,7 +10,6 @@ from benchmark.detectors.family import N_CLASSES
 from benchmark.detectors.onnx_detector import FAMILIES, OnnxDetector, check_family, infer_family, open_session
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE, parse_input_size
 from benchmark.detectors.registry import resolve_model, verify_sha256
-from metricscenes.files import sha256_file
 
 
 def load_detector(
@@ -48,19 +46,6 @@ def load_detector(
     name = entry.name if entry is not None else path.stem
     return OnnxDetector(session, path=path, name=name, family=family, sha256=digest, input_size=input_size,
                         class_map=lut, threads=threads)
-
-
-@lru_cache(maxsize=4)
-def reopen_detector(path: Path, name: str, family: str, sha256: str, input_size: str | int,
-                    class_map: tuple[int, ...] | None, threads: int | None) -> OnnxDetector:
-    """A detector that another process loaded (what :meth:`OnnxDetector.__reduce__` pickles),
-    loaded again here, once per process: the same file (:class:`DetectorError` if its sha256
-    is no longer the one recorded) and the same settings."""
-    digest = sha256_file(path)
-    if digest != sha256:
-        raise DetectorError(f"{path}: the model file changed (sha256 {digest}, the detector was loaded with {sha256})")
-    return OnnxDetector(open_session(path, threads), path=path, name=name, family=family, sha256=sha256,
-                        input_size=input_size, class_map=class_map, threads=threads)
 
 
 __all__ = ["load_detector", "DetectorError"]

@@ -8,6 +8,7 @@ dynamic (at most ``MAX_BATCH_PX`` pixels per run, to bound memory).
 from __future__ import annotations
 
 from collections import defaultdict
+from functools import lru_cache
 from pathlib import Path
 from typing import Sequence
 
@@ -20,6 +21,7 @@ from benchmark.detectors.family import N_CLASSES, Family, grid_cells
 from benchmark.detectors.letterbox import Placement, letterbox, pad_to_stride
 from benchmark.detectors.nms import batched_nms
 from benchmark.detectors.policy import Pass, parse_input_size, plan_passes
+from metricscenes.files import sha256_file
 
 FAMILIES: dict[str, Family] = {f.name: f for f in (yolov5.FAMILY, yolov8.FAMILY, yolox.FAMILY)}
 MAX_BATCH_PX = 4_000_000
@@ -125,9 +127,7 @@ class OnnxDetector:
 
     def __reduce__(self):
         """Pickled as what builds it, never as a session: another process (a sweep's worker)
-        opens the same model file again, its sha256 checked (:func:`benchmark.detectors.loader.reopen_detector`)."""
-        from benchmark.detectors.loader import reopen_detector
-
+        opens the same model file again, its sha256 checked (:func:`reopen_detector`)."""
         return reopen_detector, (self.path.absolute(), self.name, self.family, self.sha256, self.input_size,
                                  self.class_map, self.threads)
 
@@ -204,3 +204,16 @@ class OnnxDetector:
                 ]
             )
         return out
+
+
+@lru_cache(maxsize=4)
+def reopen_detector(path: Path, name: str, family: str, sha256: str, input_size: str | int,
+                    class_map: tuple[int, ...] | None, threads: int | None) -> OnnxDetector:
+    """A detector that another process loaded (what :meth:`OnnxDetector.__reduce__` pickles),
+    loaded again here, once per process: the same file (:class:`DetectorError` if its sha256
+    is no longer the one recorded) and the same settings."""
+    digest = sha256_file(path)
+    if digest != sha256:
+        raise DetectorError(f"{path}: the model file changed (sha256 {digest}, the detector was loaded with {sha256})")
+    return OnnxDetector(open_session(path, threads), path=path, name=name, family=family, sha256=sha256,
+                        input_size=input_size, class_map=class_map, threads=threads)
