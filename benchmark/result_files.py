@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -178,6 +179,22 @@ def write_results(path: str | Path, results: RunResults) -> Path:
 
 
 # ── od50.json: a run's bootstrap OD50, cached next to its detections ─────────────────────
+
+@dataclass(frozen=True)
+class RunFolder:
+    """A run folder and its parsed ``results.json`` (what compare and submit read)."""
+
+    folder: Path
+    results: RunResults
+
+    @property
+    def camera(self) -> str:
+        return self.results.camera.name
+
+    @property
+    def condition(self) -> str:
+        return self.results.condition
+
 
 class Od50Bootstrap(Record):
     """OD50 with its bootstrap spread over environments (:func:`benchmark.scoring.bootstrap_od50`).

@@ -37,11 +37,17 @@ def main() -> None:
     m = load_manifest(args.manifest)
     use_variant(args.variant)
     env = next(s for s in plan_collection(m) if s.environment.environment_id == 0).environment
-    pose = scene_mod.car_pose(env, args.distance)
-    parts = scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, pose))
     grid = m.reference_grid
-    k, cx, cy, cw, ch = inset_window(car_box_tan(scene_mod.car_vertices(env, pose)), m)
-    film = Film(grid.width_px * k, grid.height_px * k, cx, cy, cw, ch, field=grid.field)
+
+    def inset(distance: float):
+        """The scene parts with the car at ``distance`` and its inset's film."""
+        pose = scene_mod.car_pose(env, distance)
+        k, cx, cy, cw, ch = inset_window(car_box_tan(scene_mod.car_vertices(env, pose)), m)
+        return (scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, pose)),
+                Film(grid.width_px * k, grid.height_px * k, cx, cy, cw, ch, field=grid.field))
+
+    parts, film = inset(args.distance)
+    cw, ch = film.size
     spp, depth = m.render.inset_spp, m.render.max_depth
     groups = [g for g in m.light_groups if scene_mod.has_emitters(parts, g)]
 
@@ -71,14 +77,13 @@ def main() -> None:
     print(f"ratio per group / one pass: first {f1 / f2:.2f}x, second {s1 / s2:.2f}x")
     # A new window (another distance, another inset scale) keeps the one pass's kernels.
     for distance in (50.0, 100.0):
-        other = scene_mod.car_pose(env, distance)
-        other_parts = scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, other))
-        k2, x2, y2, w2, h2 = inset_window(car_box_tan(scene_mod.car_vertices(env, other)), m)
-        other_film = Film(grid.width_px * k2, grid.height_px * k2, x2, y2, w2, h2, field=grid.field)
+        other_parts, other_film = inset(distance)
         t = time.perf_counter()
         for i, pass_groups in enumerate(passes(groups)):
             render_pass(env, other_parts, pass_groups, other_film, spp=spp, seed=201 + i, max_depth=depth)
-        print(f"one pass at {distance:g} m (first render of a new window, {w2} x {h2} px, scale {k2}): "
+        w2, h2 = other_film.size
+        print(f"one pass at {distance:g} m (first render of a new window, {w2} x {h2} px, "
+              f"scale {other_film.width // grid.width_px}): "
               f"{time.perf_counter() - t:.1f} s")
     samples = cw * ch * spp * len(groups)
     print(f"samples per group and pixel, all groups: {samples / 1e6:.1f} M; "

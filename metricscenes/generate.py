@@ -86,7 +86,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.lightgroups import render_pass
-    from metricscenes.render import Film, illuminance_meter, use_variant
+    from metricscenes.render import Film, illuminance_meter, is_jit_variant, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
     use_variant(variant, threads)
@@ -119,7 +119,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
             jobs.append(("frames", "car_lights", Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field))
     illuminance = {}
     lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
-    for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=variant.startswith(("llvm", "cuda"))):
+    for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=is_jit_variant(variant)):
         images = render_pass(env, parts, groups, film, spp=spp, seed=unit.seed + 7919 * seeds[0],
                              max_depth=manifest.render.max_depth)
         for i, group in zip(seeds, groups):
@@ -173,10 +173,10 @@ def _instance_mask(manifest: Manifest, unit: Unit, env_parts, parts, film, exten
 
     from metricscenes import scene as scene_mod
     from metricscenes.lightgroups import depth_pass
-    from metricscenes.render import RenderError, render_depth
+    from metricscenes.render import RenderError, is_jit_variant, render_depth
 
     group = manifest.light_groups[0]
-    if mi.variant().startswith(("llvm", "cuda")):  # one kernel for every inset
+    if is_jit_variant(mi.variant()):  # one kernel for every inset
         depth_with, depth_without = (depth_pass(unit.environment, p, group, film, seed=unit.seed)
                                      for p in (parts, env_parts))
     else:

@@ -28,7 +28,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from metricscenes.render import RenderError
+from metricscenes.render import RenderError, is_jit_variant, load_scene
 from metricscenes.spectral import WAVELENGTHS_NM
 
 
@@ -149,18 +149,24 @@ def _trace(scene, sampler, ray, groups: _Groups, max_depth: int, rr_depth: int =
     return state[-1]
 
 
-def _window_rays(sensor, sampler, window: tuple[int, int, int, int], spp: int):
-    """Camera rays through the pixels of ``window`` (x, y, cols, rows of the sensor's whole
-    film), ``spp`` per pixel, consecutive per pixel, and their weights: what Mitsuba's
-    ``sample_rays`` does for a film cropped to the window, with the window's numbers opaque
-    so that one compiled kernel serves every window of every film of the same field and
-    aspect ratio (every inset of every environment, whatever its scale)."""
+def _window_rays(sensor, window: tuple[int, int, int, int], spp: int, seed: int):
+    """A sampler seeded with ``seed`` and the camera rays through the pixels of ``window``
+    (x, y, cols, rows of the sensor's whole film), ``spp`` per pixel, consecutive per pixel,
+    with their weights: what Mitsuba's ``sample_rays`` does for a film cropped to the
+    window, with the window's numbers, the film's size and the seed opaque (as literals,
+    each would be a kernel of its own), so that one compiled kernel serves every window of
+    every film of the same field and aspect ratio (every inset of every environment,
+    whatever its scale)."""
     import drjit as dr
     import mitsuba as mi
 
-    x0, y0, cols, _ = window
+    x0, y0, cols, rows = window
     width, height = sensor.film().size()
-    idx = dr.arange(mi.UInt32, dr.prod(window[2:]) * spp) // dr.opaque(mi.UInt32, spp)
+    sampler = sensor.sampler().fork()
+    sampler.set_sample_count(spp)
+    sampler.set_samples_per_wavefront(spp)
+    sampler.seed(dr.opaque(mi.UInt32, seed), cols * rows * spp)
+    idx = dr.arange(mi.UInt32, cols * rows * spp) // dr.opaque(mi.UInt32, spp)
     row = idx // dr.opaque(mi.UInt32, cols)
     pixel = mi.Vector2u(idx - row * dr.opaque(mi.UInt32, cols), row) + mi.Vector2u(dr.opaque(mi.UInt32, x0),
                                                                                dr.opaque(mi.UInt32, y0))
@@ -169,8 +175,20 @@ def _window_rays(sensor, sampler, window: tuple[int, int, int, int], spp: int):
     # No ray differentials: their pixel footprint would make the film's size part of the kernel
     # (the projection itself depends on the field and the aspect ratio, the same for every
     # inset scale). Nothing in the scenes filters textures by footprint.
-    return sensor.sample_ray(time=sensor.shutter_open(), sample1=sampler.next_1d(), sample2=position,
-                             sample3=mi.Vector2f(0.5))
+    ray, weight = sensor.sample_ray(time=sensor.shutter_open(), sample1=sampler.next_1d(), sample2=position,
+                                    sample3=mi.Vector2f(0.5))
+    return sampler, ray, weight
+
+
+def _window_scene(env, parts, light_groups, film, *, spp: int, seed: int, max_depth: int):
+    """The loaded scene of ``light_groups`` on ``film``'s whole film (the same for every
+    crop of it: the kernel does not change with the window), its description, and the
+    crop as the window to trace."""
+    from metricscenes import scene as scene_mod
+
+    whole = replace(film, crop_x=0, crop_y=0, crop_width=None, crop_height=None)
+    description = scene_mod.scene_dict(env, parts, light_groups, whole, spp=spp, seed=seed, max_depth=max_depth)
+    return load_scene(description), description, (film.crop_x, film.crop_y, *film.size)
 
 
 def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: int, *, spp: int, seed: int,
@@ -185,7 +203,7 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
     import drjit as dr
     import mitsuba as mi
 
-    if not mi.variant().startswith(("llvm", "cuda")):
+    if not is_jit_variant(mi.variant()):
         raise RenderError(f"one-pass light groups need a JIT variant (llvm_ad_spectral, cuda_ad_spectral), "
                           f"not {mi.variant()}")
     missing = [e for e in scene.emitters() if e not in emitter_groups]
@@ -196,11 +214,7 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
     window = window or (0, 0, *film.size())
     with dr.suspend_grad():
         film.prepare([])  # (its channels: the bands and a weight)
-        sampler = sensor.sampler().fork()
-        sampler.set_sample_count(spp)
-        sampler.set_samples_per_wavefront(spp)
-        sampler.seed(dr.opaque(mi.UInt32, seed), window[2] * window[3] * spp)  # (a literal seed: a kernel per seed)
-        ray, weight = _window_rays(sensor, sampler, window, spp)
+        sampler, ray, weight = _window_rays(sensor, window, spp, seed)
         sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
         # One kernel traces the paths; the reductions below read its stored results (left
         # lazy, each band of each group would re-trace every path in its own kernel).
@@ -242,23 +256,16 @@ def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed
     from metricscenes import scene as scene_mod
     from metricscenes.render import render_radiance
 
-    if not mi.variant().startswith(("llvm", "cuda")):
+    if not is_jit_variant(mi.variant()):
         if len(light_groups) != 1:
             raise RenderError(f"one-pass light groups need a JIT variant, not {mi.variant()}")
         description = scene_mod.scene_dict(env, parts, light_groups, film, spp=spp, seed=seed, max_depth=max_depth)
         return {light_groups[0]: render_radiance(description, spp)}
-    # The scene's film is the whole film (the same for every window of it) and the crop is
-    # the window: the kernel does not change with the window.
-    whole = replace(film, crop_x=0, crop_y=0, crop_width=None, crop_height=None)
-    description = scene_mod.scene_dict(env, parts, light_groups, whole, spp=spp, seed=seed, max_depth=max_depth)
-    try:
-        scene = mi.load_dict(description)
-    except Exception as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise RenderError(f"scene load failed: {first}") from exc
+    scene, description, window = _window_scene(env, parts, light_groups, film, spp=spp, seed=seed,
+                                               max_depth=max_depth)
     groups = scene_mod.emitter_groups(description, scene, parts, light_groups)
     images = render_light_groups(scene, groups, len(light_groups), spp=spp, seed=seed, max_depth=max_depth,
-                                 window=(film.crop_x, film.crop_y, *film.size))
+                                 window=window)
     for image in images:
         if not np.all(np.isfinite(image)):
             raise RenderError("render produced non-finite radiance")
@@ -271,23 +278,10 @@ def depth_pass(env, parts, light_group: str, film, *, seed: int) -> np.ndarray:
     the same rays), traced like :func:`render_pass`'s rays, so that on a JIT variant one
     kernel serves every inset (``render.render_depth`` compiles one per crop)."""
     import drjit as dr
-    import mitsuba as mi
 
-    from metricscenes import scene as scene_mod
-
-    whole = replace(film, crop_x=0, crop_y=0, crop_width=None, crop_height=None)
-    try:
-        scene = mi.load_dict(scene_mod.scene_dict(env, parts, light_group, whole, spp=1, seed=seed, max_depth=2))
-    except Exception as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise RenderError(f"scene load failed: {first}") from exc
-    sensor = scene.sensors()[0]
-    cols, rows = film.size
-    sampler = sensor.sampler().fork()
-    sampler.set_sample_count(1)
-    sampler.set_samples_per_wavefront(1)
-    sampler.seed(dr.opaque(mi.UInt32, seed), cols * rows)
-    ray, _ = _window_rays(sensor, sampler, (film.crop_x, film.crop_y, cols, rows), 1)
+    scene, _, window = _window_scene(env, parts, light_group, film, spp=1, seed=seed, max_depth=2)
+    _, ray, _ = _window_rays(scene.sensors()[0], window, 1, seed)
     hit = scene.ray_intersect(ray)
     distance = dr.select(hit.is_valid(), hit.t, 0.0)
+    cols, rows = film.size
     return np.asarray(distance, dtype=np.float32).reshape(rows, cols)

@@ -58,8 +58,13 @@ def check_variant(variant: str) -> None:
 
     if variant not in mi.variants():
         raise RenderError(f"Mitsuba variant {variant!r} is not available (have: {', '.join(mi.variants())})")
-    if variant.startswith(("llvm", "cuda")):
+    if is_jit_variant(variant):
         _probe_jit(variant)
+
+
+def is_jit_variant(variant: str) -> bool:
+    """Whether a Mitsuba variant compiles kernels (LLVM, CUDA) rather than running scalar code."""
+    return variant.startswith(("llvm", "cuda"))
 
 
 def resolve_variant(setting: str) -> str:
@@ -181,6 +186,22 @@ def sensor_dict(film: Film, spp: int, seed: int) -> dict:
     }
 
 
+def _first_line(exc: Exception) -> str:
+    """The first line of an exception's message (Mitsuba raises plain RuntimeErrors with long ones)."""
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def load_scene(scene_dict: dict):
+    """``mi.load_dict`` of a scene dict, a :class:`RenderError` in one line if it fails."""
+    import mitsuba as mi
+
+    try:
+        return mi.load_dict(scene_dict)
+    except Exception as exc:
+        raise RenderError(f"scene load failed: {_first_line(exc)}") from exc
+
+
 def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
     """Render a scene dict (with its sensor) to a (rows, cols, 31) float32 radiance cube."""
     import mitsuba as mi
@@ -188,9 +209,8 @@ def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
     try:
         scene = mi.load_dict(scene_dict)
         image = np.array(mi.render(scene, spp=int(spp)), dtype=np.float32)
-    except Exception as exc:  # Mitsuba raises plain RuntimeErrors with long messages
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise RenderError(f"render failed: {first}") from exc
+    except Exception as exc:
+        raise RenderError(f"render failed: {_first_line(exc)}") from exc
     if image.ndim != 3 or image.shape[2] != WAVELENGTHS_NM.size:
         raise RenderError(f"unexpected film output shape {image.shape}")
     # Negative values cannot occur in radiance; NaN would poison every later stage.
@@ -249,6 +269,5 @@ def render_depth(scene_dict: dict, film: Film) -> np.ndarray:
     try:
         image = np.array(mi.render(mi.load_dict(scene), spp=1))
     except Exception as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise RenderError(f"depth render failed: {first}") from exc
+        raise RenderError(f"depth render failed: {_first_line(exc)}") from exc
     return image[..., -1].astype(np.float32)

@@ -31,7 +31,7 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
-from benchmark.result_files import ResultsFileError, RunResults, read_results, read_sweep_record
+from benchmark.result_files import ResultsFileError, RunFolder, read_results, read_sweep_record
 from benchmark.scoring import ap_by_distance, format_od50, od50, od50_censoring
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
 
@@ -43,22 +43,12 @@ class CompareError(ValueError):
     """The two runs cannot be compared (different collections or environments, not a run)."""
 
 
-@dataclass
-class Side:
+@dataclass(frozen=True)
+class Side(RunFolder):
     """One side of a comparison: a run folder's results, ground truth and detections."""
 
-    folder: Path
-    results: RunResults
     groundtruth: dict
     detections: list
-
-    @property
-    def camera(self) -> str:
-        return self.results.camera.name
-
-    @property
-    def condition(self) -> str:
-        return self.results.condition
 
     @property
     def manifest_sha256(self) -> str:

@@ -15,12 +15,11 @@ import json
 import math
 import os
 import warnings
-from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
 from benchmark.result_files import (
-    RESULTS_FORMAT, DetectorRecord, Od50Bootstrap, Od50CacheKey, ResultsFileError, RunResults, read_od50_cache, read_results,
+    RESULTS_FORMAT, DetectorRecord, Od50Bootstrap, Od50CacheKey, ResultsFileError, RunFolder, read_od50_cache, read_results,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.leaderboard.protocols import load_protocols
@@ -31,20 +30,7 @@ from metricscenes.files import sha256_file, write_atomic
 N_RESAMPLES = BOOTSTRAP_RESAMPLES  # the one default (benchmark.scoring.bootstrap)
 
 
-@dataclass(frozen=True)
-class Run:
-    """One run folder and its parsed ``results.json``."""
-
-    folder: Path
-    results: RunResults
-
-    @property
-    def camera(self) -> str:
-        return self.results.camera.name
-
-    @property
-    def condition(self) -> str:
-        return self.results.condition
+Run = RunFolder  # one run folder and its parsed results.json
 
 
 def find_runs(results_dir: str | Path) -> list[Run]:
