@@ -65,7 +65,8 @@ def render_whole(manifest, scene_plan, film: Film, spp: int, seed: int, weights:
     """The scene, car included, rendered in one piece and mixed over the condition's light groups."""
     env = scene_plan.environment
     pose = scene_mod.car_pose(env, scene_plan.distance_m)
-    parts = scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, pose))
+    parts = scene_mod.environment_parts(env, ground_to_horizon=bool(manifest.render.ground_to_horizon))
+    parts = parts.merged(scene_mod.car_parts(env, pose))
     total = None
     for i, (group, w) in enumerate(sorted(weights.items())):
         if not scene_mod.has_emitters(parts, group):

@@ -95,7 +95,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     field = manifest.reference_grid.field
     env = unit.environment
-    parts = scene_mod.environment_parts(env)
+    parts = scene_mod.environment_parts(env, ground_to_horizon=bool(manifest.render.ground_to_horizon))
     inset = None
     started = time.perf_counter()
     if unit.kind == PLATE:

@@ -106,6 +106,14 @@ class RenderSettings(_Strict):
     )
     inset_max_px: Int = Field(512, ge=32, le=8192, description="cap on an inset's longer side, pixels")
     max_depth: Int = Field(6, ge=2, le=64, description="path length limit of the path tracer")
+    # The margins of generate.INSET_MARGIN (top: 0.2 of the car's height in a window 1.8 heights
+    # tall) keep the car out of a ramp of up to 0.1 of the window.
+    inset_feather: Float | None = Field(
+        None, gt=0.0, le=0.1, description="share of an inset's size over which, along its edges, it blends "
+        "linearly into the plate (unset: a hard edge); see metricscenes.radiance.feather_weights")
+    ground_to_horizon: bool | None = Field(
+        None, description="close the gap between the far ground's edge and the camera's horizontal (unset: "
+        "open, a black line 0.078 mrad tall); see metricscenes.assets.roads.horizon_edge")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
     # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
@@ -296,7 +304,8 @@ def canonical_sha256(data) -> str:
 # Fields added after collections were first published (paths into the manifest's JSON
 # form), omitted from the hash while unset so that every earlier manifest keeps its
 # sha256 (pinned by protocols and collections).
-HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",))
+HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "inset_feather"),
+                        ("render", "ground_to_horizon"))
 
 
 def manifest_sha256(data: dict) -> str:

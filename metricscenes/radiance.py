@@ -27,10 +27,14 @@ class RadianceLayer:
     Attributes:
         radiance: float32 array (rows, cols, bands), W·sr⁻¹·m⁻²·nm⁻¹.
         extent: the rectangle the grid covers, in tangent coordinates (x right, y down).
+        feather: for an inset, the share of its width (height) over which, along each
+            edge inside the plate, its weight against the layer below rises linearly from
+            0 to 1 (0: pasted with a hard edge). See :func:`feather_weights`.
     """
 
     radiance: np.ndarray
     extent: TanExtent
+    feather: float = 0.0
 
     @property
     def pixel_tan(self) -> tuple[float, float]:
@@ -85,24 +89,65 @@ class SpectralScene:
         extent = extent or self.extent
         out = _apply(*_weights(self.layers[0], cols, rows, extent), self.layers[0].radiance)
         for inset in self.layers[1:]:
-            _paste(out, inset, cols, rows, extent)
+            _paste(out, inset, cols, rows, extent, self.extent)
         return out.transpose(1, 2, 0)
 
 
-def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> None:
+def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray, np.ndarray]:
+    """The inset's weight against the layer below, separable: (rows,) and (cols,) float64.
+
+    Along each edge of the inset that lies inside ``within`` (the plate), the weight
+    rises linearly over ``inset.feather`` of the inset's size, from 0 at the edge to 1;
+    edges on the plate's border keep weight 1 (there is nothing to blend with). Both
+    layers estimate the same radiance without bias, so any weight between them is an
+    unbiased composite; the ramp turns the step between the plate's and the inset's
+    sampling (and noise) into a gradual one. Inside the ramp the plate, which has no
+    car, counts for part of the radiance: the margins of ``generate.INSET_MARGIN`` keep
+    the car itself out of it."""
+    rows, cols = inset.radiance.shape[:2]
+    if inset.feather <= 0.0:
+        return np.ones(rows), np.ones(cols)
+    e, tol = inset.extent, 1e-9 * within.width
+
+    def ramp(n: int, lo_inside: bool, hi_inside: bool) -> np.ndarray:
+        centres = (np.arange(n) + 0.5) / n  # pixel centres, in the inset's size
+        width = max(inset.feather, 0.5 / n)
+        w = np.ones(n)
+        if lo_inside:
+            w = np.minimum(w, centres / width)
+        if hi_inside:
+            w = np.minimum(w, (1.0 - centres) / width)
+        return np.clip(w, 0.0, 1.0)
+
+    return (ramp(rows, e.y0 > within.y0 + tol, e.y1 < within.y1 - tol),
+            ramp(cols, e.x0 > within.x0 + tol, e.x1 < within.x1 - tol))
+
+
+def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: TanExtent,
+           within: TanExtent) -> None:
     """Paste ``inset`` over band planes ``out`` (bands, rows, cols) in place: where the
-    inset covers a target pixel its radiance replaces the plate's; partly covered pixels
-    blend by covered area. Only the window the inset touches is computed."""
-    cover_x = np.asarray(_overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1],
-                                         extent.x0, extent.x1, cols).sum(axis=1)).ravel()
-    cover_y = np.asarray(_overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0],
-                                         extent.y0, extent.y1, rows).sum(axis=1)).ravel()
+    inset covers a target pixel its radiance replaces the plate's, blended by the area
+    it covers times its feather weight (:func:`feather_weights`; ``within`` is the
+    plate's extent). Only the window the inset touches is computed."""
+    overlap_x = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1], extent.x0, extent.x1, cols)
+    overlap_y = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0], extent.y0, extent.y1, rows)
+    cover_x, cover_y = (np.asarray(m.sum(axis=1)).ravel() for m in (overlap_x, overlap_y))
     jx, iy = np.flatnonzero(cover_x > 0), np.flatnonzero(cover_y > 0)
     if jx.size == 0 or iy.size == 0:
         return
     x_win, y_win = slice(jx[0], jx[-1] + 1), slice(iy[0], iy[-1] + 1)
     wy, wx = _weights(inset, cols, rows, extent)
-    values = _apply(wy[y_win], wx[x_win], inset.radiance)
+    if inset.feather > 0.0:
+        feather_y, feather_x = feather_weights(inset, within)
+        weighted = inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None]
+        # Resampled weighted radiance over resampled weight: the feathered mean of the
+        # inset pixels a target pixel overlaps; it counts for their area times weight.
+        mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
+        values = _apply(wy[y_win], wx[x_win], weighted)
+        values *= np.where(mean_weight > 0, 1.0 / np.where(mean_weight > 0, mean_weight, 1.0), 0.0).astype(np.float32)
+        cover_x, cover_y = overlap_x @ feather_x, overlap_y @ feather_y
+    else:
+        values = _apply(wy[y_win], wx[x_win], inset.radiance)
     coverage = np.outer(cover_y[y_win], cover_x[x_win])
     window = out[:, y_win, x_win]
     window *= (1.0 - coverage).astype(np.float32)

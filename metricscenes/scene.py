@@ -48,9 +48,11 @@ def car_pose(env: EnvironmentPlan, distance_m: float) -> CarPose:
     )
 
 
-def environment_parts(env: EnvironmentPlan) -> SceneParts:
-    """The road, its trees and street lights, and the camera vehicle's own head lamps."""
-    return roads.road_parts(roads.road_spec(env.road_id), seed=env.seed).merged(ego_vehicle.ego_lamp_parts())
+def environment_parts(env: EnvironmentPlan, ground_to_horizon: bool = False) -> SceneParts:
+    """The road, its trees and street lights, and the camera vehicle's own head lamps
+    (``ground_to_horizon``: see :func:`metricscenes.assets.roads.horizon_edge`)."""
+    road = roads.road_parts(roads.road_spec(env.road_id), seed=env.seed, ground_to_horizon=ground_to_horizon)
+    return road.merged(ego_vehicle.ego_lamp_parts())
 
 
 def car_parts(env: EnvironmentPlan, pose: CarPose) -> SceneParts:

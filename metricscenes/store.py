@@ -40,7 +40,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -394,7 +394,8 @@ class Collection:
         frame = self._mix("frames", scene_id, weights, scene_id, required=False)
         if frame is not None:
             plate = RadianceLayer(plate.radiance + frame.radiance, plate.extent)
-        inset = self._mix("insets", scene_id, weights, scene_id)
+        inset = replace(self._mix("insets", scene_id, weights, scene_id),
+                        feather=self.manifest.render.inset_feather or 0.0)
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
         return SpectralScene(
             layers=layers,

@@ -102,6 +102,23 @@ def test_ground_reaches_the_horizon():
         assert scene.ray_test(mi.Ray3f(mi.Point3f(0, 0, 1.5), d)), np.degrees(az)
 
 
+@pytest.mark.parametrize("closed", [False, True])
+def test_ground_to_horizon_closes_the_strip_below_the_horizontal(closed):
+    """Between the far ground's edge (20 km) and the camera's horizontal lies a strip 0.078 mrad
+    tall where nothing is hit (sunsky is black there): ``ground_to_horizon`` closes it with a
+    face towards the camera, and nothing rises above the horizontal."""
+    scene = mi.load_dict(_scene(roads.road_parts(roads.road_spec(3), seed=1, ground_to_horizon=closed)))
+    origin = mi.Point3f(0, 0, 1.5)
+    for az in np.radians([-0.5, 0.0, 0.5]):
+        for elevation_mrad, hit in ((-0.03, closed), (-0.07, closed), (-0.09, True), (0.01, False)):
+            e = elevation_mrad * 1e-3
+            d = mi.Vector3f(np.cos(az) * np.cos(e), np.sin(az) * np.cos(e), np.sin(e))
+            si = scene.ray_intersect(mi.Ray3f(origin, d))
+            assert bool(si.is_valid()) == hit, (np.degrees(az), elevation_mrad)
+            if hit:
+                assert np.dot(np.ravel(si.n), np.ravel(d)) < 0  # seen from its front: a one-sided diffuse face is lit there
+
+
 def test_street_light_illuminance_follows_its_candela_table():
     """E = I cos(i) / d² from the luminaire's table (cover + spot), read as L = ρ E / π."""
     flux_lm, height_m, rho = 10_000.0, 9.0, 0.5

@@ -13,7 +13,7 @@ from benchmark.camera import camera_from_dict
 from benchmark.experiments.run import collection_field
 from metricscenes.geometry import REFERENCE_EXTENT, field_extent, fov_deg
 from metricscenes.groundtruth import box_tan_to_xywh, car_box_tan
-from metricscenes.manifest import ManifestError, canonical_sha256, load_manifest, parse_manifest
+from metricscenes.manifest import ManifestError, load_manifest, parse_manifest
 
 MANIFESTS = Path(__file__).resolve().parents[1] / "manifests"
 WIDE = {
@@ -24,15 +24,20 @@ WIDE = {
 }
 
 
+# The hashes the committed collections, results and reference submissions were made under.
+PUBLISHED_SHA256 = {"quick": "c6ffcfba3035d5c7b5c3daf4a89328c9cf8e1ae91529fb7d00272840f112652e",
+                    "smoke": "a8ca4cecf92284ca884223b2777fe51db0c2849219f857491eed583d165a5507"}
+
+
 def test_earlier_manifests_keep_their_hash():
-    for name in ("quick", "smoke", "metric-300"):
+    for name, sha256 in PUBLISHED_SHA256.items():
         m = load_manifest(MANIFESTS / f"{name}.yaml")
         assert m.reference_grid.hfov_deg is None and m.reference_grid.field is REFERENCE_EXTENT
-        dumped = m.model_dump(mode="json")
-        del dumped["reference_grid"]["hfov_deg"], dumped["store"]  # unset later fields are not hashed
-        assert m.sha256() == canonical_sha256(dumped)
+        assert m.sha256() == sha256  # fields added later (HASHED_ONLY_WHEN_SET) count only once set
     assert parse_manifest(WIDE).sha256() != parse_manifest({**WIDE, "reference_grid": {
         **WIDE["reference_grid"], "hfov_deg": 61.0}}).sha256()
+    for render in ({"inset_feather": 0.1}, {"ground_to_horizon": False}):
+        assert parse_manifest(WIDE).sha256() != parse_manifest({**WIDE, "render": {**WIDE["render"], **render}}).sha256()
 
 
 @pytest.mark.parametrize("grid, words", [
@@ -43,6 +48,8 @@ def test_earlier_manifests_keep_their_hash():
 def test_bad_fields_are_refused(grid, words):
     with pytest.raises(ManifestError, match=words):
         parse_manifest({**WIDE, "reference_grid": grid})
+    with pytest.raises(ManifestError, match="render.inset_feather"):  # past the inset's margins
+        parse_manifest({**WIDE, "render": {**WIDE["render"], "inset_feather": 0.3}})
 
 
 def test_field_follows_hfov_and_aspect():
@@ -59,8 +66,10 @@ def test_a_wide_collection_renders_and_maps_its_own_field(tmp_path):
     from metricscenes.scene import car_pose, car_vertices
     from metricscenes.store import Collection
 
-    manifest = parse_manifest(WIDE)
+    # With this session's fidelity settings too: the skirt renders, and the reader feathers the inset.
+    manifest = parse_manifest({**WIDE, "render": {**WIDE["render"], "inset_feather": 0.05, "ground_to_horizon": True}})
     collection = Collection.open(generate(manifest, tmp_path / "wide"))
+    assert [layer.feather for layer in collection.radiance("env000-d025m", "day").layers] == [0.0, 0.05]
     field = field_extent(60.0, 128, 96)
     assert collection.field == field and collection_field(collection) == field
     (plate,) = [layer for layer in collection.angular_sampling("env000-d025m") if layer["layer"] == "plate"]

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, pixels_to_tan, tan_to_pixels, world_to_tan
-from metricscenes.radiance import RadianceLayer, SpectralScene
+from metricscenes.radiance import RadianceLayer, SpectralScene, feather_weights
 
 
 def _area(e: TanExtent) -> float:
@@ -68,3 +68,42 @@ def test_tangent_and_pixel_coordinates_round_trip():
     assert p[0] < 960 and p[1] > 540
     px = np.array([[12.5, 99.0], [1919.0, 0.5]])
     np.testing.assert_allclose(tan_to_pixels(pixels_to_tan(px, 1920, 1080), 1920, 1080), px)
+
+
+def _feathered_pair(feather: float, fine_value: float = 3.0):
+    """A plate of ones and an inset (40 x 64 px, 4x finer than a 160 x 90 grid, on its pixel edges)."""
+    e = REFERENCE_EXTENT
+    ext = TanExtent(e.x0 + 40 * e.width / 160, e.y0 + 20 * e.height / 90, e.x0 + 56 * e.width / 160, e.y0 + 30 * e.height / 90)
+    plate = RadianceLayer(np.ones((9, 16, 2), np.float32), REFERENCE_EXTENT)
+    return plate, RadianceLayer(np.full((40, 64, 2), fine_value, np.float32), ext, feather=feather)
+
+
+def test_feathered_inset_blends_by_its_weight_area_averaged():
+    plate, inset = _feathered_pair(0.1)
+    wy, wx = feather_weights(inset, REFERENCE_EXTENT)
+    # Linear ramps over 10 % of each side (4 of 40 rows, 6.4 of 64 columns), 1 inside, symmetric.
+    np.testing.assert_allclose(wy[:5], [0.125, 0.375, 0.625, 0.875, 1.0])
+    np.testing.assert_allclose(wx[:7], np.minimum((np.arange(7) + 0.5) / 6.4, 1.0))
+    np.testing.assert_allclose(wx, wx[::-1])
+    out = SpectralScene(layers=(plate, inset), wavelengths_nm=np.array([500.0, 510.0])).resample(160, 90)
+    # Each output pixel averages 4 x 4 inset pixels: plate + (inset - plate) x their mean weight.
+    weight = np.outer(wy, wx).reshape(10, 4, 16, 4).mean(axis=(1, 3))
+    np.testing.assert_allclose(out[20:30, 40:56, 0], 1.0 + 2.0 * weight, rtol=1e-5)
+    np.testing.assert_allclose(out[25, 48, :], 3.0, rtol=1e-6)  # the middle keeps the inset alone
+    assert np.all(out[:20] == 1.0) and np.all(out[:, :40] == 1.0)  # nothing outside the window
+
+
+def test_feathering_keeps_equal_layers_equal_and_is_off_by_default():
+    plate, inset = _feathered_pair(0.08, fine_value=1.0)
+    out = SpectralScene(layers=(plate, inset), wavelengths_nm=np.array([500.0, 510.0])).resample(123, 77)
+    np.testing.assert_allclose(out, 1.0, rtol=1e-6)  # a blend of two equal estimates changes nothing
+    hard = RadianceLayer(inset.radiance, inset.extent)
+    assert hard.feather == 0.0 and all(np.all(w == 1.0) for w in feather_weights(hard, REFERENCE_EXTENT))
+
+
+def test_feather_leaves_edges_on_the_plate_border_hard():
+    e = REFERENCE_EXTENT
+    inset = RadianceLayer(np.ones((20, 40, 1), np.float32), TanExtent(e.x0, 0.0, 0.0, e.y1), feather=0.1)
+    wy, wx = feather_weights(inset, REFERENCE_EXTENT)
+    assert wx[0] == 1.0 and wx[-1] == pytest.approx(0.125)  # left edge on the border; right inside (4 px ramp)
+    assert wy[0] == pytest.approx(0.25) and wy[-1] == 1.0  # top inside (2 px ramp); bottom on the border

@@ -20,6 +20,7 @@ from metricscenes.assets.lamps import STREET_LIGHT_FLUX_LM
 from metricscenes.assets.parts import SceneParts, mesh_shape
 from metricscenes.assets.streetlights import street_light_parts
 from metricscenes.assets.vegetation import diffuse_bsdf, tree_parts
+from metricscenes.geometry import CAMERA_HEIGHT_M
 
 N_ROADS = 20
 ROAD_X_RANGE_M = (-5.0, 395.0)
@@ -180,8 +181,24 @@ def _toned_meshes(prefix: str, rows: list[np.ndarray], material: str, brightness
     return shapes
 
 
-def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0) -> SceneParts:
-    """All shapes and lamps of a road (keys 'road_*', 'tree_*', 'streetlight_*'), seeded."""
+def horizon_edge() -> meshes.Mesh:
+    """A vertical face along the far ground's edge ahead, from the ground up to the camera's
+    height, facing the camera. Without it the camera sees, between the ground's edge and its
+    own horizontal, a strip 1.55 m / 20 km = 0.078 mrad tall where ``sunsky`` is zero: a black
+    line along the horizon once a render samples finer than about 0.3 mrad (an inset does).
+    On the real Earth the ground reaches the horizon, 0.69 mrad below the horizontal from
+    1.5 m (dip ≈ √(2h/R)); a flat world cannot place it there, so the ground is closed up
+    to the horizontal instead, with the far ground's material."""
+    g = FAR_GROUND_HALF_SIZE_M
+    v = np.array([[g, -g, FAR_GROUND_Z_M], [g, -g, CAMERA_HEIGHT_M], [g, g, CAMERA_HEIGHT_M], [g, g, FAR_GROUND_Z_M]])
+    return v, np.array([[0, 1, 2], [0, 2, 3]])  # counter-clockwise seen from the camera (-x)
+
+
+def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_horizon: bool = False) -> SceneParts:
+    """All shapes and lamps of a road (keys 'road_*', 'tree_*', 'streetlight_*'), seeded.
+
+    ``ground_to_horizon`` closes the strip between the far ground's edge and the camera's
+    horizontal (see :func:`horizon_edge`)."""
     rng = np.random.default_rng([_SALT, spec.road_id, int(seed)])
     yc = centre_line_y_m(spec, camera_lane)
     half_lanes, half_paved = spec.lanes_each_way * spec.lane_width_m, spec.half_paved_m
@@ -217,6 +234,8 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0) -> ScenePart
     g = FAR_GROUND_HALF_SIZE_M
     v, f = meshes.quads_z([[-g, g, -g, g, FAR_GROUND_Z_M]])
     shapes["road_ground_far"] = mesh_shape("road_ground_far", v, f, diffuse_bsdf(spec.terrain, 0.9))
+    if ground_to_horizon:
+        shapes["road_ground_edge"] = mesh_shape("road_ground_edge", *horizon_edge(), diffuse_bsdf(spec.terrain, 0.9))
     parts = SceneParts(shapes=shapes)
     margin = 1.5 + verge
     if spec.trees:
