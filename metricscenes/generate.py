@@ -59,14 +59,20 @@ def plan_units(scenes: list[ScenePlan]) -> list[Unit]:
 def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
     """Choose the inset film: scale ``k`` of the reference grid and the crop (x, y, w, h)
     in that film's pixels. ``k`` gives ``inset_pixel_mrad`` sampling unless the window
-    would exceed ``inset_max_px`` (near cars, which are large in every camera anyway)."""
+    would exceed ``inset_max_px`` (near cars, which are large in every camera anyway).
+    With ``render.inset_feather`` the window also holds the ramp over which the reader
+    blends it into the plate (:func:`metricscenes.radiance.feather_weights`)."""
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     e = manifest.reference_grid.field
     bw, bh = box_tan[2] - box_tan[0], box_tan[3] - box_tan[1]
-    x0 = max(e.x0, box_tan[0] - INSET_MARGIN["left"] * bw)
-    x1 = min(e.x1, box_tan[2] + INSET_MARGIN["right"] * bw)
-    y0 = max(e.y0, box_tan[1] - INSET_MARGIN["top"] * bh)
-    y1 = min(e.y1, box_tan[3] + INSET_MARGIN["bottom"] * bh)
+    x0, x1 = box_tan[0] - INSET_MARGIN["left"] * bw, box_tan[2] + INSET_MARGIN["right"] * bw
+    y0, y1 = box_tan[1] - INSET_MARGIN["top"] * bh, box_tan[3] + INSET_MARGIN["bottom"] * bh
+    if manifest.render.inset_feather:
+        # The blend ramp (a share f of the window at each side) lies outside the margins, so the
+        # car and all it changes nearby keep the inset's full weight: W' (1 - 2 f) = W.
+        grow = manifest.render.inset_feather / (1.0 - 2.0 * manifest.render.inset_feather)
+        x0, x1, y0, y1 = x0 - grow * (x1 - x0), x1 + grow * (x1 - x0), y0 - grow * (y1 - y0), y1 + grow * (y1 - y0)
+    x0, x1, y0, y1 = max(e.x0, x0), min(e.x1, x1), max(e.y0, y0), min(e.y1, y1)
     ref_pitch_mrad = 1e3 * e.width / ref_w
     window_ref_px = max((x1 - x0) / e.width * ref_w, (y1 - y0) / e.height * ref_h)
     k_fine = math.ceil(ref_pitch_mrad / manifest.render.inset_pixel_mrad)

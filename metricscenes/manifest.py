@@ -106,11 +106,10 @@ class RenderSettings(_Strict):
     )
     inset_max_px: Int = Field(512, ge=32, le=8192, description="cap on an inset's longer side, pixels")
     max_depth: Int = Field(6, ge=2, le=64, description="path length limit of the path tracer")
-    # The margins of generate.INSET_MARGIN (top: 0.2 of the car's height in a window 1.8 heights
-    # tall) keep the car out of a ramp of up to 0.1 of the window.
     inset_feather: Float | None = Field(
         None, gt=0.0, le=0.1, description="share of an inset's size over which, along its edges, it blends "
-        "linearly into the plate (unset: a hard edge); see metricscenes.radiance.feather_weights")
+        "linearly into the plate; the window grows by it, outside the car's margins (unset: a hard edge); see "
+        "metricscenes.radiance.feather_weights and metricscenes.generate.inset_window")
     ground_to_horizon: bool | None = Field(
         None, description="close the gap between the far ground's edge and the camera's horizontal (unset: "
         "open, a black line 0.078 mrad tall); see metricscenes.assets.roads.horizon_edge")

@@ -98,12 +98,12 @@ def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray
 
     Along each edge of the inset that lies inside ``within`` (the plate), the weight
     rises linearly over ``inset.feather`` of the inset's size, from 0 at the edge to 1;
-    edges on the plate's border keep weight 1 (there is nothing to blend with). Both
-    layers estimate the same radiance without bias, so any weight between them is an
-    unbiased composite; the ramp turns the step between the plate's and the inset's
-    sampling (and noise) into a gradual one. Inside the ramp the plate, which has no
-    car, counts for part of the radiance: the margins of ``generate.INSET_MARGIN`` keep
-    the car itself out of it."""
+    edges on the plate's border keep weight 1 (there is nothing to blend with). Where
+    the car changes nothing, both layers estimate the same radiance without bias, so any
+    weight between them gives an unbiased composite; the ramp turns the step between the plate's and the inset's
+    sampling (and noise) into a gradual one. The plate has no car, so inside the ramp
+    the car's shadow and occlusion would fade: ``generate.inset_window`` grows the window
+    by the ramp, outside the car's margins."""
     rows, cols = inset.radiance.shape[:2]
     if inset.feather <= 0.0:
         return np.ones(rows), np.ones(cols)

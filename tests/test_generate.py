@@ -219,3 +219,21 @@ def test_boxes_come_from_the_instance_mask_and_agree_with_the_projection(smoke_c
         assert mask.dtype == bool and 0 < mask.mean() < 1
         box = mask_box_tan(mask, TanExtent(*arr.attrs["extent_tan"]))
         np.testing.assert_allclose(box_tan_to_xywh(box, img["width"], img["height"]), boxes[img["id"]], atol=1e-3)
+
+
+def test_feathered_inset_window_holds_the_ramp_outside_the_margins(smoke_manifest):
+    from metricscenes.generate import inset_window
+    from metricscenes.manifest import parse_manifest
+
+    data = smoke_manifest.model_dump(mode="json")
+    data["render"].update(inset_max_px=4096)  # the same scale k for both windows
+    hard = parse_manifest(data)
+    data["render"].update(inset_feather=0.1)
+    feathered = parse_manifest(data)
+    box = (-0.01, 0.0, 0.01, 0.012)  # tangent units, in the middle of the field
+    k, x, y, w, h = inset_window(box, hard)
+    k2, x2, y2, w2, h2 = inset_window(box, feathered)
+    assert k2 == k
+    # W' (1 - 2 f) = W: the full-weight middle is the hard window (to a pixel of rounding per edge).
+    assert abs(w2 * 0.8 - w) <= 2 and abs(h2 * 0.8 - h) <= 2
+    assert abs((x2 + w2 / 2) - (x + w / 2)) <= 1 and abs((y2 + h2 / 2) - (y + h / 2)) <= 1
