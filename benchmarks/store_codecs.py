@@ -44,9 +44,11 @@ import time
 import warnings
 from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
+from metricscenes.geometry import TanExtent
 from metricscenes.store import (
     GROUNDTRUTH_FILE, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, Collection, array_sha256, read_checked, verify_collection,
 )
@@ -238,9 +240,18 @@ def codec_study(collection: Collection, environments: list[int], widths: list[in
               f"{sum(x['subnormal'] for x in e)} ({max(x['subnormal_abs'] for x in e):.1e}) |")
 
 
-def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """The unit's radiance arrays rendered with its own seed and with another: path -> (a, b).
-    Renders are kept in ``work`` and reused by later runs."""
+class Renders(NamedTuple):
+    """One radiance array rendered with the unit's own seed (``a``) and with another (``b``),
+    and the extent (tangent coordinates) its grid covers."""
+
+    a: np.ndarray
+    b: np.ndarray
+    extent: TanExtent
+
+
+def render_twice(manifest, unit_key: str, work: Path) -> dict[str, Renders]:
+    """The unit's radiance arrays rendered with its own seed and with another: path ->
+    :class:`Renders`. Renders are kept in ``work`` and reused by later runs."""
     import zarr
 
     from metricscenes.generate import plan_units, render_unit
@@ -265,8 +276,9 @@ def render_twice(manifest, unit_key: str, work: Path) -> dict[str, tuple[np.ndar
     pairs = {}
     for path in records[0][1]["arrays"]:
         if not path.startswith("masks/"):
-            pairs[path] = tuple(np.asarray(zarr.open_group(str(root / RADIANCE_STORE), mode="r")[path][...])
-                                for root, _ in records)
+            arrays = [zarr.open_group(str(root / RADIANCE_STORE), mode="r")[path] for root, _ in records]
+            pairs[path] = Renders(*(np.asarray(arr[...]) for arr in arrays),
+                                  TanExtent(*arrays[0].attrs["extent_tan"]))
     return pairs
 
 
@@ -307,12 +319,12 @@ def noise_and_rounding(a: np.ndarray, b: np.ndarray, widths: list[int]) -> dict:
     return out
 
 
-def noise_manifest(collection: Collection, manifest_path: Path | None, light_groups: list[str] | None):
-    """The manifest the noise units are rendered with: the collection's, or another (e.g.
-    metric-300: its grid and spp), with only ``light_groups`` rendered (they cost the time)."""
-    from metricscenes.manifest import load_manifest, parse_manifest
+def noise_manifest(manifest, light_groups: list[str] | None):
+    """The manifest the noise units are rendered with: ``manifest`` (the collection's, or
+    another, e.g. metric-300: its grid and spp) with only ``light_groups`` rendered (they
+    cost the time)."""
+    from metricscenes.manifest import parse_manifest
 
-    manifest = load_manifest(manifest_path) if manifest_path else collection.manifest
     if not light_groups:
         return manifest
     data = manifest.model_dump(mode="json", exclude={"store", "illuminance_sweep"})
@@ -328,7 +340,7 @@ def noise_study(collection: Collection, manifest, units: list[str], widths: list
           flush=True)
     rows = []
     for unit in units:
-        for path, (a, b) in render_twice(manifest, unit, work / unit).items():
+        for path, (a, b, _) in render_twice(manifest, unit, work / unit).items():
             same = (array_sha256(a) == collection.resolved.arrays.get(path)
                     if manifest.sha256() == collection.manifest_sha256 else None)  # None: another manifest
             rows.append((path, same, noise_and_rounding(a, b, widths)))
@@ -349,8 +361,6 @@ def noise_study(collection: Collection, manifest, units: list[str], widths: list
 
 def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | None) -> tuple[Path, dict[str, str]]:
     """A copy of the collection's store written by the store's writer; the sha256 it returns per array."""
-    from metricscenes.geometry import TanExtent
-
     shutil.rmtree(out, ignore_errors=True)
     (out / RADIANCE_STORE).mkdir(parents=True)
     shutil.copy(collection.root / RADIANCE_STORE / "zarr.json", out / RADIANCE_STORE / "zarr.json")  # root attributes
@@ -467,7 +477,10 @@ def main() -> None:
     if args.whole:
         whole_store(collection, args.mantissa_bits, args.work, args.metric300, args.keep)
     elif args.noise_units:
-        manifest = noise_manifest(collection, args.noise_manifest, args.noise_light_groups)
+        from metricscenes.manifest import load_manifest
+
+        base = load_manifest(args.noise_manifest) if args.noise_manifest else collection.manifest
+        manifest = noise_manifest(base, args.noise_light_groups)
         noise_study(collection, manifest, args.noise_units, args.mantissa_bits, args.work)
     else:
         codec_study(collection, args.environments, args.mantissa_bits, args.slow, args.work)
