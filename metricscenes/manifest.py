@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
 from pathlib import Path
@@ -116,6 +117,17 @@ class RenderSettings(_Strict):
     # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
     # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
+
+    @field_validator("plate_spp", "inset_spp")
+    @classmethod
+    def _square(cls, value: int) -> int:
+        # Mitsuba's stratified sampler rounds any other count up to a square (32 -> 36), so the
+        # renders would not have the samples recorded for them.
+        if math.isqrt(value) ** 2 != value:
+            root = math.isqrt(value)
+            raise ValueError(f"must be a square (the stratified sampler rounds {value} to {(root + 1) ** 2}): "
+                             f"e.g. {root ** 2} or {(root + 1) ** 2}")
+        return value
 
 
 _ILLUMINANCE_CONDITION = re.compile(r"(?P<base>[^@]+)@(?P<lux>[0-9.eE+-]+)lux")

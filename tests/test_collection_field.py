@@ -19,7 +19,7 @@ MANIFESTS = Path(__file__).resolve().parents[1] / "manifests"
 WIDE = {
     "name": "wide60", "protocol": "smoke", "seed": 5, "environments": 1, "distances_m": [25, 50],
     "reference_grid": {"width_px": 128, "height_px": 96, "hfov_deg": 60.0},  # 4:3, 60° x 46.8°
-    "render": {"plate_spp": 2, "inset_spp": 2, "inset_pixel_mrad": 1.0, "inset_max_px": 96, "max_depth": 3},
+    "render": {"plate_spp": 4, "inset_spp": 4, "inset_pixel_mrad": 1.0, "inset_max_px": 96, "max_depth": 3},
     "light_groups": ["sky_day"], "conditions": {"day": {"sky_day": 1.0}},
 }
 

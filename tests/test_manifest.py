@@ -24,6 +24,7 @@ def test_packaged_manifests_validate(name):
         (lambda d: d.update(environments=0), "environments"),
         (lambda d: d.update(distances_m=[50, 25]), "distances_m"),
         (lambda d: d["render"].update(plate_spp="many"), "render.plate_spp"),
+        (lambda d: d["render"].update(inset_spp=32), "render.inset_spp"),  # not a square: 36 would be rendered
         (lambda d: d["reference_grid"].update(height_px=200), "reference_grid"),
         (lambda d: d["conditions"].update(dusk={"sky_dusk": 1.0}), "conditions.dusk.sky_dusk"),
         (lambda d: d.update(colour="blue"), "colour"),
