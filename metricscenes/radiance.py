@@ -100,10 +100,10 @@ def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray
     rises linearly over ``inset.feather`` of the inset's size, from 0 at the edge to 1;
     edges on the plate's border keep weight 1 (there is nothing to blend with). Where
     the car changes nothing, both layers estimate the same radiance without bias, so any
-    weight between them gives an unbiased composite; the ramp turns the step between the plate's and the inset's
-    sampling (and noise) into a gradual one. The plate has no car, so inside the ramp
-    the car's shadow and occlusion would fade: ``generate.inset_window`` grows the window
-    by the ramp, outside the car's margins."""
+    weight between them gives an unbiased composite; the ramp turns the step between
+    their samplings (and noise levels) into a gradual one. The plate has no car, so
+    inside the ramp the car's shadow and occlusion would fade: ``generate.inset_window``
+    grows the window by the ramp, outside the car's margins."""
     rows, cols = inset.radiance.shape[:2]
     if inset.feather <= 0.0:
         return np.ones(rows), np.ones(cols)
@@ -144,7 +144,7 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
         # inset pixels a target pixel overlaps; it counts for their area times weight.
         mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
         values = _apply(wy[y_win], wx[x_win], weighted)
-        values *= np.where(mean_weight > 0, 1.0 / np.where(mean_weight > 0, mean_weight, 1.0), 0.0).astype(np.float32)
+        values *= np.divide(1.0, mean_weight, out=np.zeros_like(mean_weight), where=mean_weight > 0).astype(np.float32)
         cover_x, cover_y = overlap_x @ feather_x, overlap_y @ feather_y
     else:
         values = _apply(wy[y_win], wx[x_win], inset.radiance)
