@@ -34,13 +34,14 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from metricscenes import __version__
 from metricscenes.geometry import TanExtent, fov_deg
-from metricscenes.radiance import RadianceLayer, SpectralScene
+from metricscenes.radiance import SpectralScene
 from metricscenes.spectral import RADIANCE_UNITS, photon_energy_j
 from metricscenes.store import Collection
 
@@ -80,8 +81,7 @@ def composite(scene: SpectralScene, cols: int, rows: int) -> np.ndarray:
     out = np.empty((rows, cols, bands), dtype=np.float32)
     for b0 in range(0, bands, _BANDS_PER_PASS):
         sl = slice(b0, min(bands, b0 + _BANDS_PER_PASS))
-        part = SpectralScene(layers=tuple(RadianceLayer(layer.radiance[..., sl], layer.extent)
-                                          for layer in scene.layers))
+        part = SpectralScene(layers=tuple(replace(layer, radiance=layer.radiance[..., sl]) for layer in scene.layers))
         out[..., sl] = part.resample(cols, rows)
     return out
 

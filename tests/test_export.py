@@ -109,3 +109,12 @@ def test_cli_export_writes_the_file(smoke_collection, tmp_path):
     assert proc.returncode == 0, proc.stderr
     with h5py.File(tmp_path / "y.h5", "r") as f:
         assert f["photons"].shape == (108, 192, 31) and f.attrs["condition"] == "night"
+
+
+def test_composite_in_band_passes_keeps_the_feather():
+    from metricscenes.export import composite
+
+    rng = np.random.default_rng(3)
+    inset = RadianceLayer(rng.random((40, 64, 31), dtype=np.float32), TanExtent(-0.05, -0.03, 0.07, 0.05), feather=0.1)
+    scene = SpectralScene(layers=(RadianceLayer(rng.random((27, 48, 31), dtype=np.float32), REFERENCE_EXTENT), inset))
+    np.testing.assert_array_equal(composite(scene, 192, 108), scene.resample(192, 108))
