@@ -169,18 +169,19 @@ def unit_renders(manifest, unit: str, work: Path) -> dict[str, dict[str, Renders
     return layers
 
 
-def scenes(layers: dict[str, dict[str, Renders]], unit: str):
+def scenes(layers: dict[str, dict[str, Renders]], unit: str, inset_feather: float):
     """The two SpectralScenes (render A, render B) a camera is handed: each layer the sum
-    of its light groups (weight 1: the day condition is ``{sky_day: 1}``)."""
+    of its light groups (weight 1: the day condition is ``{sky_day: 1}``), the inset
+    feathered as the store's reader does (``Collection.radiance``)."""
     from metricscenes.radiance import RadianceLayer, SpectralScene
 
     out = []
     for which in ("a", "b"):
         stack = []
-        for renders in layers.values():
+        for name, renders in layers.items():
             first = next(iter(renders.values()))
             total = sum(np.asarray(getattr(r, which), np.float32) for r in renders.values())
-            stack.append(RadianceLayer(total, first.extent))
+            stack.append(RadianceLayer(total, first.extent, feather=inset_feather if name == "inset" else 0.0))
         out.append(SpectralScene(layers=tuple(stack), metadata={"unit": unit, "render": which}))
     return out
 
@@ -255,7 +256,7 @@ def measure(manifest, units: list[str], camera, work: Path, window: int, dark_e:
     for unit in units:
         layers = unit_renders(manifest, unit, work)
         started = time.perf_counter()
-        scene_a, scene_b = scenes(layers, unit)
+        scene_a, scene_b = scenes(layers, unit, manifest.render.inset_feather or 0.0)
         e_a, e_b, exposure_s, own_b = capture_pair(scene_a, scene_b, camera)
         used, left_out = used_pixels(e_a, e_b, saturation, dark)
         print(f"  {unit}: captured in {time.perf_counter() - started:.0f} s; exposure {1e3 * exposure_s:.3f} ms "

@@ -123,8 +123,8 @@ class RenderSettings(_Strict):
     def _square(cls, value: int) -> int:
         # Mitsuba's stratified sampler rounds any other count up to a square (32 -> 36), so the
         # renders would not have the samples recorded for them.
-        if math.isqrt(value) ** 2 != value:
-            root = math.isqrt(value)
+        root = math.isqrt(value)
+        if root**2 != value:
             raise ValueError(f"must be a square (the stratified sampler rounds {value} to {(root + 1) ** 2}): "
                              f"e.g. {root ** 2} or {(root + 1) ** 2}")
         return value
