@@ -121,8 +121,9 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         jobs = [("insets", g, film, manifest.render.inset_spp, extent) for g in manifest.light_groups]
         if "car_lights" in manifest.light_groups:
             # The car's lamps light the road far outside its inset (an oncoming car's beams
-            # reach the camera): that group also gets a whole frame at plate sampling.
-            jobs.append(("frames", "car_lights", Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field))
+            # reach the camera): that group also gets a whole frame at plate sampling, or coarser.
+            jobs.append(("frames", "car_lights", Film(*manifest.frame_grid_px(), field=field),
+                         manifest.render.plate_spp, field))
     illuminance = {}
     lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
     for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=is_jit_variant(variant)):

@@ -114,6 +114,11 @@ class RenderSettings(_Strict):
     ground_to_horizon: bool | None = Field(
         None, description="close the gap between the far ground's edge and the camera's horizontal (unset: "
         "open, a black line 0.078 mrad tall); see metricscenes.assets.roads.horizon_edge")
+    frame_divisor: Int | None = Field(
+        None, ge=2, le=8, description="render the car lamps' whole frame (frames/<scene>/car_lights) on a grid this "
+        "many times coarser than the plates' (unset: the plates' grid); the reader interpolates it onto the plate's "
+        "grid. The beams' footprint on the road is smooth and the lamps themselves are in the inset; see "
+        "docs/performance.md, 'Car-lamp frames'")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
     # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
@@ -247,6 +252,20 @@ class Manifest(_Strict):
                     raise ValueError(f"illuminance_sweep.lamps_on: {group!r} is not a rendered lamp group")
         return self
 
+    @model_validator(mode="after")
+    def _frame_grid(self) -> "Manifest":
+        divisor, grid = self.render.frame_divisor, self.reference_grid
+        if divisor is not None and (grid.width_px % divisor or grid.height_px % divisor):
+            raise ValueError(f"render.frame_divisor: {divisor} must divide the reference grid "
+                             f"({grid.width_px} x {grid.height_px} px)")
+        return self
+
+    def frame_grid_px(self) -> tuple[int, int]:
+        """(width, height) of the car lamps' whole frame: the reference grid, or it divided
+        by ``render.frame_divisor``."""
+        divisor = self.render.frame_divisor or 1
+        return self.reference_grid.width_px // divisor, self.reference_grid.height_px // divisor
+
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
         return manifest_sha256(self.model_dump(mode="json"))
@@ -316,7 +335,7 @@ def canonical_sha256(data) -> str:
 # form), omitted from the hash while unset so that every earlier manifest keeps its
 # sha256 (pinned by protocols and collections).
 HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "inset_feather"),
-                        ("render", "ground_to_horizon"))
+                        ("render", "ground_to_horizon"), ("render", "frame_divisor"))
 
 
 def manifest_sha256(data: dict) -> str:
