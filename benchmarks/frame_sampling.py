@@ -139,11 +139,12 @@ def main() -> None:
                          float(np.median((e_a + e_x)[used] / 2)) if used.any() else float("nan"), exposure_s))
     print(f"\nA = the collection's scene under {args.condition}; the other frame in its place; noise-free "
           f"{camera.name} captures at A's exposure; lit: at least {dark:g} e- and below {saturation:.0f} e-\n")
-    print("| scene | frame against A's | frame grid | render s | time vs full | lit px | median e- | "
+    print("| scene | exposure ms | frame against A's | frame grid | render s | time vs full | lit px | median e- | "
           "ratio overall | windows median / p90 |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for unit, name, size, seconds, rel, st, median_e, _ in rows:
-        print(f"| {unit} | {name} | {size} | {seconds:.1f} | {rel:.3f} | {100 * st['used']:.1f} % | {median_e:.0f} | "
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for unit, name, size, seconds, rel, st, median_e, exposure_s in rows:
+        print(f"| {unit} | {1e3 * exposure_s:.3f} | {name} | {size} | {seconds:.1f} | {rel:.3f} | {100 * st['used']:.1f} % "
+              f"| {median_e:.0f} | "
               f"{st['overall']:.3f} | {st['median']:.3f} / {st['p90']:.3f} |")
 
 

@@ -384,7 +384,8 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
 
 def metric300_pixels(manifest_path: Path) -> dict[str, float]:
     """Pixels of the units of one metric-300 environment, by kind (each unit counted once,
-    whatever its light groups): plate and frames on its reference grid, insets sized by
+    whatever its light groups): plate on its reference grid, frames on theirs
+    (``render.frame_divisor``), insets sized by
     its plan (``inset_window``, mean over its environments); and its number of environments."""
     from metricscenes import scene as scene_mod
     from metricscenes.generate import inset_window
@@ -400,8 +401,8 @@ def metric300_pixels(manifest_path: Path) -> dict[str, float]:
         _, _, _, w, h = inset_window(car_box_tan(scene_mod.car_vertices(s.environment, pose)), m)
         inset_px += w * h
     grid = m.reference_grid.width_px * m.reference_grid.height_px
-    per_env_scenes = len(m.distances_m)
-    return {"plates": grid, "frames": grid * per_env_scenes, "insets": inset_px / m.environments,
+    frame_w, frame_h = m.frame_grid_px()
+    return {"plates": grid, "frames": frame_w * frame_h * len(m.distances_m), "insets": inset_px / m.environments,
             "environments": m.environments}
 
 
