@@ -15,7 +15,7 @@ coarser (B_d, its own seed), with metricscenes' render path
 The camera is handed the scene under the condition (the collection's plate, frame and
 inset, as ``Collection.radiance`` gives it: A) and the same with the frame replaced by A'
 or by B_d interpolated onto the plate's grid, as the reader does for a collection made
-with ``frame_divisor`` (``store._on_grid_of``). All are captured with every sensor noise
+with ``frame_divisor`` (``radiance.on_grid_of``). All are captured with every sensor noise
 off, at A's exposure. Per pair, as in ``render_noise.py``: sqrt(sum (e_1 - e_2)^2 / 2 /
 sum e) over the pixels lit (at least ``--dark-e`` e- on average, below saturation), the
 whole frame and 32 x 32 windows (median, 90th percentile). A against A' is the render
@@ -78,11 +78,10 @@ def with_frame(scene, frame_a: np.ndarray, frame: np.ndarray, weight: float):
     plate's grid as the store's reader does."""
     from dataclasses import replace
 
-    from metricscenes.radiance import RadianceLayer
-    from metricscenes.store import _on_grid_of
+    from metricscenes.radiance import RadianceLayer, on_grid_of
 
     plate = scene.layers[0]
-    other = _on_grid_of(RadianceLayer(frame, plate.extent), plate)
+    other = on_grid_of(RadianceLayer(frame, plate.extent), plate)
     radiance = plate.radiance - np.float32(weight) * frame_a + np.float32(weight) * other
     return replace(scene, layers=(RadianceLayer(radiance, plate.extent), *scene.layers[1:]))
 

@@ -93,6 +93,16 @@ class SpectralScene:
         return out.transpose(1, 2, 0)
 
 
+def on_grid_of(layer: RadianceLayer, target: RadianceLayer) -> np.ndarray:
+    """``layer``'s radiance on ``target``'s grid: as it is where the grids are the same, else
+    resampled (:meth:`SpectralScene.resample`: linear between a coarser grid's pixel centres),
+    e.g. a car-lamp frame rendered with ``render.frame_divisor``."""
+    rows, cols = target.radiance.shape[:2]
+    if layer.radiance.shape[:2] == (rows, cols) and layer.extent == target.extent:
+        return layer.radiance
+    return SpectralScene(layers=(layer,)).resample(cols, rows, target.extent)
+
+
 def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray, np.ndarray]:
     """The inset's weight against the layer below, separable: (rows,) and (cols,) float64.
 

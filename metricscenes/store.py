@@ -51,7 +51,7 @@ from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store AP
 from metricscenes.manifest import (
     Manifest, ManifestError, illuminance_condition, manifest_sha256, parse_illuminance_condition, parse_manifest,
 )
-from metricscenes.radiance import RadianceLayer, SpectralScene
+from metricscenes.radiance import RadianceLayer, SpectralScene, on_grid_of
 from metricscenes.records import ResolvedManifest, resolved_content_sha256
 
 RADIANCE_STORE = "radiance.zarr"
@@ -121,16 +121,6 @@ def read_checked(root: Path, group, path: str, expected: str | None, label: str)
                                   + ("" if has_chunk else " (its chunk is missing)"))
         _CHECKED.add(fingerprint)
     return data, attrs
-
-
-def _on_grid_of(layer: RadianceLayer, target: RadianceLayer) -> np.ndarray:
-    """``layer``'s radiance on ``target``'s grid: as it is where the grids are the same, else
-    resampled (:meth:`SpectralScene.resample`: linear between a coarser grid's pixel centres),
-    e.g. a car-lamp frame rendered with ``render.frame_divisor``."""
-    rows, cols = target.radiance.shape[:2]
-    if layer.radiance.shape[:2] == (rows, cols) and layer.extent == target.extent:
-        return layer.radiance
-    return SpectralScene(layers=(layer,)).resample(cols, rows, target.extent)
 
 
 def _extent(attrs: dict, label: str, path: str) -> TanExtent:
@@ -403,7 +393,7 @@ class Collection:
         plate = self._mix("plates", f"env{img['environment_id']:03d}", weights, scene_id)
         frame = self._mix("frames", scene_id, weights, scene_id, required=False)
         if frame is not None:
-            plate = RadianceLayer(plate.radiance + _on_grid_of(frame, plate), plate.extent)
+            plate = RadianceLayer(plate.radiance + on_grid_of(frame, plate), plate.extent)
         inset = replace(self._mix("insets", scene_id, weights, scene_id),
                         feather=self.manifest.render.inset_feather or 0.0)
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
