@@ -8,6 +8,8 @@ Layout of a collection folder::
       plates/<env>/<light_group>        (y, x, wavelength) float32, whole field of view
       insets/<scene>/<light_group>      (y, x, wavelength) float32, a window around the car
       frames/<scene>/car_lights         (y, x, wavelength) float32, the car's lamps over the whole view
+                                        (the plates' grid, or render.frame_divisor times coarser: read
+                                        onto the plate's grid, radiance.on_grid_of)
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, the Mitsuba variant that
