@@ -3,26 +3,16 @@ add it: the same frame gives the same scene, a coarser uniform one adds uniforml
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from metricscenes.geometry import REFERENCE_EXTENT
 from metricscenes.radiance import RadianceLayer, SpectralScene
 
-BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
-
 
 @pytest.fixture(scope="module")
-def frame_sampling():
-    with pytest.MonkeyPatch.context() as mp:
-        mp.syspath_prepend(str(BENCHMARKS))
-        spec = importlib.util.spec_from_file_location("frame_sampling", BENCHMARKS / "frame_sampling.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        yield module
+def frame_sampling(load_benchmark):
+    return load_benchmark("frame_sampling")
 
 
 def test_with_frame_replaces_the_frame_on_the_plates_grid(frame_sampling):

@@ -3,24 +3,13 @@ come out as that size, whatever the signal's texture."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
-
 
 @pytest.fixture(scope="module")
-def render_noise():
-    """The script as a module (it imports its sibling store_codecs from benchmarks/)."""
-    with pytest.MonkeyPatch.context() as mp:
-        mp.syspath_prepend(str(BENCHMARKS))
-        spec = importlib.util.spec_from_file_location("render_noise", BENCHMARKS / "render_noise.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        yield module
+def render_noise(load_benchmark):
+    return load_benchmark("render_noise")
 
 
 def textured_mean(shape=(256, 384), seed=0) -> np.ndarray:

@@ -4,23 +4,13 @@ and the estimate separates that loss from the noise the projection removes."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
-
 
 @pytest.fixture(scope="module")
-def spectral_basis():
-    with pytest.MonkeyPatch.context() as mp:
-        mp.syspath_prepend(str(BENCHMARKS))
-        spec = importlib.util.spec_from_file_location("spectral_basis", BENCHMARKS / "spectral_basis.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        yield module
+def spectral_basis(load_benchmark):
+    return load_benchmark("spectral_basis")
 
 
 def rank3_pair(noise: float, seed: int = 0, shape=(64, 96)):
