@@ -91,7 +91,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     (the manifest's, ``auto`` resolved); return its progress record (the caller writes it)."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
-    from metricscenes.lightgroups import render_pass
+    from metricscenes.lightgroups import meter_pass, render_pass
     from metricscenes.render import Film, illuminance_meter, is_jit_variant, use_variant
 
     manifest = Manifest.model_validate(manifest_json)
@@ -126,16 +126,23 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
                          manifest.render.plate_spp, field))
     illuminance = {}
     lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
-    for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=is_jit_variant(variant)):
+    one_pass = is_jit_variant(variant)
+    for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=one_pass):
         images = render_pass(env, parts, groups, film, spp=spp, seed=unit.seed + 7919 * seeds[0],
                              max_depth=manifest.render.max_depth)
-        for i, group in zip(seeds, groups):
+        for group in groups:
             arrays.write_radiance(kind, group, images[group], extent, {"spp": spp, "seed": unit.seed})
-            if unit.kind == PLATE:
-                sd = scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
-                                          max_depth=manifest.render.max_depth)
-                irradiance = illuminance_meter(sd, seed=unit.seed + 7919 * i)
-                illuminance[group] = round(float(radiance_to_xyz(irradiance)[1]), 9)
+        if unit.kind != PLATE:
+            continue
+        if one_pass:  # the pass's groups in one trace, with a kernel shared by every plate
+            irradiance = meter_pass(env, parts, groups, seed=unit.seed + 7919 * seeds[0],
+                                    max_depth=manifest.render.max_depth)
+        else:
+            irradiance = {group: illuminance_meter(
+                scene_mod.scene_dict(env, parts, group, film, spp=spp, seed=unit.seed + 7919 * i,
+                                     max_depth=manifest.render.max_depth), seed=unit.seed + 7919 * i)
+                for i, group in zip(seeds, groups)}
+        illuminance.update({g: round(float(radiance_to_xyz(e)[1]), 9) for g, e in irradiance.items()})
     return UnitRecord(unit=unit.key, kind=unit.kind, arrays=arrays.sha256,
                       seconds=round(time.perf_counter() - started, 3),
                       illuminance_lux=illuminance or None,  # (a plate no group lights records none)

@@ -28,7 +28,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from metricscenes.render import RenderError, is_jit_variant, load_scene
+from metricscenes.geometry import CAMERA_HEIGHT_M
+from metricscenes.render import ILLUMINANCE_METER_SPP, RenderError, is_jit_variant, load_scene, with_illuminance_patch
 from metricscenes.spectral import WAVELENGTHS_NM
 
 
@@ -270,6 +271,54 @@ def render_pass(env, parts, light_groups: Sequence[str], film, *, spp: int, seed
         if not np.all(np.isfinite(image)):
             raise RenderError("render produced non-finite radiance")
     return dict(zip(light_groups, images))
+
+
+def meter_pass(env, parts, light_groups: Sequence[str], *, seed: int, max_depth: int,
+               spp: int = ILLUMINANCE_METER_SPP, height_m: float = CAMERA_HEIGHT_M,
+               at_xy_m: tuple[float, float] = (0.0, 0.0)) -> dict[str, np.ndarray]:
+    """Horizontal spectral irradiance (31,) W·m⁻²·nm⁻¹ at (x, y, height_m) of each of
+    ``light_groups``, from one trace (JIT variants): :func:`metricscenes.render.illuminance_meter`'s
+    white patch seen from 10 cm above, E = π L, its ``spp`` rays followed by the one-pass
+    integrator. The point and the seed are opaque, so one kernel serves every plate of
+    every environment (a radiance meter's ``mi.render`` is a kernel of its own per group
+    and unit: on a GPU, seconds of compiling each)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    from metricscenes import scene as scene_mod
+    from metricscenes.render import Film
+
+    description = with_illuminance_patch(
+        scene_mod.scene_dict(env, parts, light_groups, Film(1, 1), spp=spp, seed=seed, max_depth=max_depth),
+        height_m, at_xy_m)
+    scene = load_scene(description)
+    groups = scene_mod.emitter_groups(description, scene, parts, light_groups)
+    sensor = scene.sensors()[0]
+    film = sensor.film()
+    bands = WAVELENGTHS_NM.size
+    with dr.suspend_grad():
+        film.prepare([])
+        sampler = sensor.sampler().fork()
+        sampler.set_sample_count(spp)
+        sampler.set_samples_per_wavefront(spp)
+        sampler.seed(dr.opaque(mi.UInt32, seed), spp)
+        # The film's sensitivities choose the wavelengths, as a radiance meter's sample_ray does.
+        wavelengths, weight = sensor.sample_wavelengths(dr.zeros(mi.SurfaceInteraction3f), sampler.next_1d())
+        above = mi.Point3f(*(dr.opaque(mi.Float, v) for v in (*map(float, at_xy_m), height_m + 0.1)))
+        ray = mi.Ray3f(above, mi.Vector3f(0.0, 0.0, -1.0), 0.0, wavelengths)
+        sums = _trace(scene, sampler, ray, _Groups(groups, len(light_groups)), max_depth)
+        dr.eval(sums, wavelengths, weight)
+        per_group = [[dr.block_sum(c, spp) / spp
+                      for c in film.prepare_sample(radiance * weight, wavelengths, bands + 1, weight=1.0,
+                                                   alpha=1.0)[:bands]]
+                     for radiance in sums]
+        dr.eval(per_group)
+    out = {g: np.pi * np.array([float(c[0]) for c in bands_of], dtype=np.float64)
+           for g, bands_of in zip(light_groups, per_group)}
+    for g, irradiance in out.items():
+        if not np.all(np.isfinite(irradiance)):
+            raise RenderError(f"illuminance meter of {g}: non-finite irradiance")
+    return out
 
 
 def depth_pass(env, parts, light_group: str, film, *, seed: int) -> np.ndarray:

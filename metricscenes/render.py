@@ -222,6 +222,19 @@ def render_radiance(scene_dict: dict, spp: int) -> np.ndarray:
 ILLUMINANCE_METER_SPP = 1024
 
 
+def with_illuminance_patch(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M,
+                           at_xy_m: tuple[float, float] = (0.0, 0.0)) -> dict:
+    """``scene_dict`` with the illuminance meter's target: a 2 cm white Lambertian square
+    (reflectance 1) facing up at (x, y, height_m)."""
+    import mitsuba as mi
+
+    return {**scene_dict, "illuminance_patch": {
+        "type": "rectangle",
+        "to_world": mi.ScalarTransform4f().translate([*map(float, at_xy_m), height_m]).scale(0.01),
+        "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": 1.0}},
+    }}
+
+
 def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed: int = 0,
                       at_xy_m: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """Horizontal spectral irradiance (31,) W·m⁻²·nm⁻¹ at (x, y, height_m) in a scene dict.
@@ -231,14 +244,7 @@ def illuminance_meter(scene_dict: dict, height_m: float = CAMERA_HEIGHT_M, seed:
     delta lights (the moon as a directional emitter) through emitter sampling. The
     scene's own sensor is replaced.
     """
-    import mitsuba as mi
-
-    scene = {k: v for k, v in scene_dict.items() if k != "sensor"}
-    scene["illuminance_patch"] = {
-        "type": "rectangle",
-        "to_world": mi.ScalarTransform4f().translate([*map(float, at_xy_m), height_m]).scale(0.01),
-        "bsdf": {"type": "diffuse", "reflectance": {"type": "uniform", "value": 1.0}},
-    }
+    scene = with_illuminance_patch({k: v for k, v in scene_dict.items() if k != "sensor"}, height_m, at_xy_m)
     scene["sensor"] = {
         "type": "radiancemeter", "origin": [*map(float, at_xy_m), height_m + 0.1], "direction": [0.0, 0.0, -1.0],
         "film": spectral_film_dict(Film(1, 1)),
