@@ -192,6 +192,21 @@ def _window_scene(env, parts, light_groups, film, *, spp: int, seed: int, max_de
     return load_scene(description), description, (film.crop_x, film.crop_y, *film.size)
 
 
+def _band_means(film, sums, wavelengths, weight, spp: int) -> list[list]:
+    """Each group's radiance samples (``sums``) binned by the film into its bands (and a
+    unit weight), as ``specfilm`` does, and averaged over each run of ``spp`` consecutive
+    lanes (a pixel's samples): a block sum in a fixed order, no atomic adds, the same bits
+    on every run and thread count. Evaluated: per group, one array per band."""
+    import drjit as dr
+
+    bands = WAVELENGTHS_NM.size
+    per_group = [[dr.block_sum(c, spp) / spp
+                  for c in film.prepare_sample(radiance * weight, wavelengths, bands + 1, weight=1.0, alpha=1.0)[:bands]]
+                 for radiance in sums]
+    dr.eval(per_group)
+    return per_group
+
+
 def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: int, *, spp: int, seed: int,
                         max_depth: int, window: tuple[int, int, int, int] | None = None) -> list[np.ndarray]:
     """Render a loaded scene (a ``specfilm`` sensor with a ``box`` filter, every group's
@@ -220,15 +235,8 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
         # One kernel traces the paths; the reductions below read its stored results (left
         # lazy, each band of each group would re-trace every path in its own kernel).
         dr.eval(sums, ray.wavelengths, weight)
-        bands = WAVELENGTHS_NM.size
-        per_group = []
-        for radiance in sums:
-            # The film bins a sample into its bands (and a unit weight); a pixel's samples
-            # are consecutive lanes, so their mean is a block sum in a fixed order: no
-            # atomic adds, the same bits on every run and thread count.
-            channels = film.prepare_sample(radiance * weight, ray.wavelengths, bands + 1, weight=1.0, alpha=1.0)
-            per_group.append([dr.block_sum(c, spp) / spp for c in channels[:bands]])
-        dr.eval(per_group)
+        per_group = _band_means(film, sums, ray.wavelengths, weight, spp)
+    bands = WAVELENGTHS_NM.size
     cols, rows = window[2:]
     images = [np.stack([np.asarray(c, dtype=np.float32) for c in group], axis=-1).reshape(rows, cols, bands)
               for group in per_group]
@@ -295,7 +303,6 @@ def meter_pass(env, parts, light_groups: Sequence[str], *, seed: int, max_depth:
     groups = scene_mod.emitter_groups(description, scene, parts, light_groups)
     sensor = scene.sensors()[0]
     film = sensor.film()
-    bands = WAVELENGTHS_NM.size
     with dr.suspend_grad():
         film.prepare([])
         sampler = sensor.sampler().fork()
@@ -308,11 +315,7 @@ def meter_pass(env, parts, light_groups: Sequence[str], *, seed: int, max_depth:
         ray = mi.Ray3f(above, mi.Vector3f(0.0, 0.0, -1.0), 0.0, wavelengths)
         sums = _trace(scene, sampler, ray, _Groups(groups, len(light_groups)), max_depth)
         dr.eval(sums, wavelengths, weight)
-        per_group = [[dr.block_sum(c, spp) / spp
-                      for c in film.prepare_sample(radiance * weight, wavelengths, bands + 1, weight=1.0,
-                                                   alpha=1.0)[:bands]]
-                     for radiance in sums]
-        dr.eval(per_group)
+        per_group = _band_means(film, sums, wavelengths, weight, spp)
     out = {g: np.pi * np.array([float(c[0]) for c in bands_of], dtype=np.float64)
            for g, bands_of in zip(light_groups, per_group)}
     for g, irradiance in out.items():
