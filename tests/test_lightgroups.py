@@ -57,8 +57,7 @@ def _measure(seed: int = 11) -> dict:
         render's mean is one draw: robust to noise correlated between pixels), and the
         ratio of their pixel noise."""
         ma, mb = np.array([x.mean() for x in a]), np.array([x.mean() for x in b])
-        t = (ma.mean() - mb.mean()) / np.sqrt(ma.var(ddof=1) / ma.size + mb.var(ddof=1) / mb.size)
-        return {"t": float(t), "noise_ratio": float((a[0] - a[1]).std() / (b[0] - b[1]).std()),
+        return {"t": _t(ma, mb), "noise_ratio": float((a[0] - a[1]).std() / (b[0] - b[1]).std()),
                 "mean": float(ma.mean())}
 
     out = {g: compare([o[g] for o in one], [a[g] for a in alone]) for g in GROUPS}
@@ -91,12 +90,12 @@ def _meters(env, depth: int, seeds) -> dict:
     alone = {g: [radiance_to_xyz(illuminance_meter(
         scene_mod.scene_dict(env, parts, g, Film(4, 4), spp=1, seed=0, max_depth=depth), seed=4000 + s))[1]
         for s in seeds] for g in groups}
-    out = {}
-    for g in groups:
-        a, b = np.array(one[g]), np.array(alone[g])
-        spread = np.sqrt(a.var(ddof=1) / a.size + b.var(ddof=1) / b.size)
-        out[g] = {"t": float((a.mean() - b.mean()) / spread) if spread > 0 else 0.0, "mean": float(a.mean())}
-    return out
+    return {g: {"t": _t(np.array(one[g]), np.array(alone[g])), "mean": float(np.mean(one[g]))} for g in groups}
+
+
+def _t(a: np.ndarray, b: np.ndarray) -> float:
+    """Welch's t of the difference of the means of two sets of independent estimates."""
+    return float((a.mean() - b.mean()) / np.sqrt(a.var(ddof=1) / a.size + b.var(ddof=1) / b.size))
 
 
 @pytest.mark.slow
