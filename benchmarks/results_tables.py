@@ -1,0 +1,171 @@
+"""The tables of docs/results.md, made from the sweep folders rather than typed.
+
+    PYTHONPATH=. python benchmarks/results_tables.py publish --results results --out docs/data
+    PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data
+
+``publish`` copies each sweep's ``sweep.csv`` and ``od50.csv`` into ``docs/data`` under the
+names the docs and tests/test_results_findings.py read (``-640``, ``-native``,
+``-illuminance``, ``-policies``; the policy tables gain an ``exposure`` column, the reference
+policy's rows coming from the reference sweep). ``markdown`` prints the tables of
+docs/results.md from those files: AP per distance with Spearman's ρ and OD50 per condition,
+the input-size comparison, the acquisition policies and the illuminance sweep.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from benchmark.experiments.acceptance import ap_distance_rho
+from benchmark.experiments.sweep import od50_cell, with_censoring
+
+REFERENCE_POLICY = "auto_peak (reference)"
+POLICIES = {"percentile:99": "quick-policy-percentile-99", "mean_level@0.18": "quick-policy-mean_level-0.18",
+            "hdr:16": "quick-policy-hdr-16"}
+SWEEPS = {"": "quick", "-640": "quick-640", "-native": "quick-native", "-illuminance": "quick-lux"}
+
+
+def publish(results: Path, out: Path) -> None:
+    """docs/data's CSVs from the sweep folders under ``results``."""
+    out.mkdir(parents=True, exist_ok=True)
+    for suffix, folder in SWEEPS.items():
+        for name in ("sweep", "od50"):
+            (out / f"{name}{suffix}.csv").write_bytes((results / folder / f"{name}.csv").read_bytes())
+    reference_cameras = set(pd.read_csv(results / next(iter(POLICIES.values())) / "sweep.csv")["camera"])
+    for name in ("sweep", "od50"):
+        parts = []
+        reference = pd.read_csv(results / "quick" / f"{name}.csv")
+        reference = reference[reference["camera"].isin(reference_cameras)
+                              & reference["condition"].isin(["dusk", "night"])]
+        parts.append(reference.assign(exposure=REFERENCE_POLICY))
+        parts += [pd.read_csv(results / folder / f"{name}.csv").assign(exposure=policy)
+                  for policy, folder in POLICIES.items()]
+        pd.concat(parts, ignore_index=True).to_csv(out / f"{name}-policies.csv", index=False)
+
+
+def _minus(text: str) -> str:
+    return text.replace("-", "−")
+
+
+def _od50_text(row, *, whole_metres: bool = False) -> str:
+    """OD50 ± SD, the bound when censored, or the 95 % interval where the SD exceeds half the OD50."""
+    if not row.get("censored") and np.isfinite(row["od50_m"]) and row["sd_m"] > row["od50_m"] / 2:
+        return f"{row['od50_m']:.0f} (95 %: {row['ci95_lo_m']:.0f}–{row['ci95_hi_m']:.0f})"
+    return _od50_metres(row) if whole_metres else od50_cell(row)
+
+
+def _od50_metres(row, *, sd: bool = True) -> str:
+    """OD50 in whole metres (± SD), or its bound when censored."""
+    if row.get("censored"):
+        return od50_cell(row)
+    return f"{row['od50_m']:.0f} ± {row['sd_m']:.0f}" if sd else f"{row['od50_m']:.0f}"
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(cells) + " |"
+
+
+def _rule(n: int) -> str:
+    return "|" + "---|" * n
+
+
+def ap_table(table: pd.DataFrame, od50: pd.DataFrame, condition: str) -> str:
+    """camera | MTF50 | AP per distance | Spearman ρ | OD50, one condition."""
+    rows = table[table["condition"] == condition]
+    distances = sorted(rows["distance_m"].unique())
+    rho = ap_distance_rho(table, condition)
+    lines = [_row(["camera", "MTF50", *(f"{d:g} m" for d in distances), "Spearman ρ", "OD50 (m)"]),
+             _rule(len(distances) + 4)]
+    od50 = od50[od50["condition"] == condition].set_index("camera")
+    for camera, part in rows.groupby("camera"):
+        ap = part.set_index("distance_m")["ap"]
+        r = rho.get(camera, np.nan)
+        lines.append(_row([camera, f"{part['mtf50_cy_per_mm'].iloc[0]:.1f}", *(f"{ap[d]:.2f}" for d in distances),
+                           "—" if np.isnan(r) else _minus(f"{r:.2f}"), _od50_text(od50.loc[camera])]))
+    return "\n".join(lines)
+
+
+def input_size_table(data: Path) -> str:
+    """OD50 and ρ by day under the three input-size policies."""
+    sides = {name: _load(data, suffix) for name, suffix in (("native", "-native"), ("640", "-640"), ("multiscale", ""))}
+    lines = [_row(["camera", "MTF50", *(f"OD50 {n} (m)" for n in sides), *(f"ρ {n}" for n in sides)]),
+             _rule(8)]
+    rhos = {n: ap_distance_rho(t, "day") for n, (t, _) in sides.items()}
+    day = {n: o[o["condition"] == "day"].set_index("camera") for n, (_, o) in sides.items()}
+    for camera, row in day["multiscale"].iterrows():
+        cells = [_od50_metres(d.loc[camera], sd=False) for d in day.values()]
+        lines.append(_row([camera, f"{row['mtf50_cy_per_mm']:.1f}", *cells,
+                           *(_minus(f"{rhos[n][camera]:.2f}") for n in sides)]))
+    return "\n".join(lines)
+
+
+def policy_tables(data: Path) -> str:
+    """AP at 25 m / AP at 50 m / OD50 ± SD per camera and policy, dusk then night."""
+    table = pd.read_csv(data / "sweep-policies.csv")
+    od50 = pd.read_csv(data / "od50-policies.csv")
+    policies = list(dict.fromkeys(table["exposure"]))
+    out = []
+    for condition in ("dusk", "night"):
+        header = [p.replace("auto_peak", "`auto_peak`") if p == REFERENCE_POLICY else f"`{p}`" for p in policies]
+        lines = [_row(["camera", *header]), _rule(len(policies) + 1)]
+        for camera in dict.fromkeys(table.loc[table["exposure"] != REFERENCE_POLICY, "camera"]):
+            first = table[table["camera"] == camera].iloc[0]
+            cells = [f"{camera} ({first['pixel_um']:g} µm, f/{first['f_number']:g})"]
+            for policy in policies:
+                part = table[(table["camera"] == camera) & (table["condition"] == condition) & (table["exposure"] == policy)]
+                ap = part.set_index("distance_m")["ap"]
+                o = od50[(od50["camera"] == camera) & (od50["condition"] == condition) & (od50["exposure"] == policy)]
+                cell = _od50_metres(with_censoring(o, part).iloc[0])
+                cells.append(f"{ap[25.0]:.2f} / {ap[50.0]:.2f} / {cell}")
+            lines.append(_row(cells))
+        out.append(f"{condition.capitalize()}:\n\n" + "\n".join(lines))
+    return "\n\n".join(out)
+
+
+def illuminance_table(data: Path) -> str:
+    """AP at 25 and 50 m and OD50 per illuminance level."""
+    table, od50 = _load(data, "-illuminance")
+    levels = list(dict.fromkeys(table["condition"]))
+    lux = [c.split("@")[1].removesuffix("lux") for c in levels]
+    od50 = od50.set_index("condition")
+    lines = [_row(["illuminance (lux)", *lux]), _rule(len(lux) + 1)]
+    for d in (25.0, 50.0):
+        ap = table[table["distance_m"] == d].set_index("condition")["ap"]
+        lines.append(_row([f"AP at {d:g} m", *(f"{ap[c]:.2f}" for c in levels)]))
+    lines.append(_row(["OD50 (m)", *(_od50_text(od50.loc[c], whole_metres=True) for c in levels)]))
+    return "\n".join(lines)
+
+
+def _load(data: Path, suffix: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+    table = pd.read_csv(data / f"sweep{suffix}.csv")
+    return table, with_censoring(pd.read_csv(data / f"od50{suffix}.csv"), table)
+
+
+def markdown(data: Path) -> str:
+    table, od50 = _load(data, "")
+    parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", "night")]
+    parts += [f"### input size (day)\n\n{input_size_table(data)}", f"### policies\n\n{policy_tables(data)}",
+              f"### illuminance\n\n{illuminance_table(data)}"]
+    return "\n\n".join(parts)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("publish", help="copy the sweeps' tables into docs/data")
+    p.add_argument("--results", type=Path, default=Path("results"))
+    p.add_argument("--out", type=Path, default=Path("docs/data"))
+    m = sub.add_parser("markdown", help="print docs/results.md's tables")
+    m.add_argument("--data", type=Path, default=Path("docs/data"))
+    args = parser.parse_args()
+    if args.command == "publish":
+        publish(args.results, args.out)
+    else:
+        print(markdown(args.data))
+
+
+if __name__ == "__main__":
+    main()
