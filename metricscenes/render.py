@@ -22,6 +22,12 @@ from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
 _active_variant: str | None = None
 CPU_VARIANT = "scalar_spectral"
 GPU_VARIANT = "cuda_ad_spectral"
+BLOCK_SIZE_PX = 32
+"""The scalar renderer's image block, fixed (Mitsuba's default). Left unset, Mitsuba halves it
+until a film has a block per render thread, and a pixel's random numbers follow its block:
+a small film (a far car's inset) then rendered other bytes with another thread count, i.e.
+another worker count or machine. 32 is what every film of more blocks than threads already
+got, so collections made before keep their bytes."""
 
 
 class RenderError(RuntimeError):
@@ -263,7 +269,7 @@ def render_depth(scene_dict: dict, film: Film) -> np.ndarray:
 
     cols, rows = film.size
     scene = dict(scene_dict)
-    scene["integrator"] = {"type": "aov", "aovs": "dd:depth"}
+    scene["integrator"] = {"type": "aov", "aovs": "dd:depth", "block_size": BLOCK_SIZE_PX}
     sensor = dict(scene["sensor"])
     sensor["film"] = {
         "type": "hdrfilm", "width": film.width, "height": film.height, "crop_offset_x": film.crop_x,

@@ -17,7 +17,7 @@ import numpy as np
 from metricscenes.assets import cars, ego_vehicle, roads, skies
 from metricscenes.assets.parts import SceneParts
 from metricscenes.plan import EnvironmentPlan
-from metricscenes.render import Film, sensor_dict
+from metricscenes.render import BLOCK_SIZE_PX, Film, sensor_dict
 
 SKY_GROUPS = {"sky_day": "sky_day_id", "sky_dusk": "sky_dusk_id", "sky_night": "sky_night_id"}
 
@@ -89,7 +89,7 @@ def scene_dict(
         raise ValueError(f"a scene holds one sky, got {skies_on}")
     scene: dict = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": int(max_depth)},
+        "integrator": {"type": "path", "max_depth": int(max_depth), "block_size": BLOCK_SIZE_PX},
         "sensor": sensor_dict(film, spp, seed),
     }
     scene.update(parts.shapes)
