@@ -359,8 +359,10 @@ def noise_study(collection: Collection, manifest, units: list[str], widths: list
         print("| worst | | | | " + " | ".join(f"{100 * ok:.2f} % / {r:.4f}" for ok, r in worst.values()) + " |")
 
 
-def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | None) -> tuple[Path, dict[str, str]]:
-    """A copy of the collection's store written by the store's writer; the sha256 it returns per array."""
+def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | None,
+                       spectral_basis: int | None = None) -> tuple[Path, dict[str, str]]:
+    """A copy of the collection's store written by the store's writer (with ``store``
+    settings ``mantissa_bits``, ``spectral_basis``); the sha256 it returns per array."""
     shutil.rmtree(out, ignore_errors=True)
     (out / RADIANCE_STORE).mkdir(parents=True)
     shutil.copy(collection.root / RADIANCE_STORE / "zarr.json", out / RADIANCE_STORE / "zarr.json")  # root attributes
@@ -377,7 +379,7 @@ def rewrite_collection(collection: Collection, out: Path, mantissa_bits: int | N
         else:
             kind, unit, light_group = path.split("/")
             extra = {k: v for k, v in attrs.items() if k in ("spp", "seed")}
-            unit_arrays = CollectionWriter(out).unit_arrays(unit, mantissa_bits)
+            unit_arrays = CollectionWriter(out).unit_arrays(unit, mantissa_bits, spectral_basis)
             written[path] = unit_arrays.write_radiance(kind, light_group, data, extent, extra)
     return out, written
 
@@ -406,17 +408,22 @@ def metric300_pixels(manifest_path: Path) -> dict[str, float]:
             "environments": m.environments}
 
 
-def whole_store(collection: Collection, widths: list[int], work: Path, metric300: Path, keep: bool) -> None:
-    """Sizes of the whole store: as it is, rewritten lossless, rewritten with BitRound."""
+def whole_store(collection: Collection, widths: list[int], work: Path, metric300: Path, keep: bool,
+                spectral_basis: int | None = None) -> None:
+    """Sizes of the whole store: as it is, rewritten lossless, rewritten with BitRound (and,
+    with ``spectral_basis`` K, with BitRound on the coefficients of a K-spectra basis)."""
     envs = len({s.environment_id for s in collection.scenes()})
     n_scenes = len(collection.scenes())
     variants: dict[str, Path] = {"as stored (zarr default: zstd 0)": collection.root}
     print(f"\nwhole store: {collection.root} ({envs} environments, {n_scenes} scenes); "
           f"load {os.getloadavg()[0]:.1f}; writing copies under {work}", flush=True)
-    for bits in [None, *widths]:
+    settings = [(None, None), *((bits, None) for bits in widths)]
+    settings += [(bits, spectral_basis) for bits in widths] if spectral_basis else []
+    for bits, basis in settings:
         name = "store chain, lossless" if bits is None else f"BitRound {bits} + store chain"
+        name = name if basis is None else f"spectral basis {basis}, {name}"
         started = time.perf_counter()
-        out, written = rewrite_collection(collection, work / f"whole-{bits or 'lossless'}", bits)
+        out, written = rewrite_collection(collection, work / f"whole-{bits or 'lossless'}-{basis or 31}", bits, basis)
         seconds = time.perf_counter() - started
         if bits is None:  # the lossless copy is the same collection: every recorded sha256 must hold
             for name_ in (RESOLVED_MANIFEST_FILE, GROUNDTRUTH_FILE):
@@ -470,13 +477,14 @@ def main() -> None:
     parser.add_argument("--metric300", type=Path, default=Path("manifests/metric-300.yaml"))
     parser.add_argument("--work", type=Path, default=Path("/tmp/store-codecs"), help="scratch folder")
     parser.add_argument("--keep", action="store_true", help="keep the --whole copies")
+    parser.add_argument("--spectral-basis", type=int, help="--whole: also each width on a basis of this many spectra")
     args = parser.parse_args()
     # The numcodecs bridge warns that its codecs are outside the zarr v3 specification: said in the table.
     warnings.filterwarnings("ignore", message=".*not in the Zarr version 3 specification.*")
     collection = Collection.open(args.collection)
     args.work.mkdir(parents=True, exist_ok=True)
     if args.whole:
-        whole_store(collection, args.mantissa_bits, args.work, args.metric300, args.keep)
+        whole_store(collection, args.mantissa_bits, args.work, args.metric300, args.keep, args.spectral_basis)
     elif args.noise_units:
         from metricscenes.manifest import load_manifest
 

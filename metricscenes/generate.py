@@ -97,7 +97,9 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     manifest = Manifest.model_validate(manifest_json)
     use_variant(variant, threads)
     # This unit's arrays, and nothing else: every array has one writer.
-    arrays = CollectionWriter(out_dir).unit_arrays(unit.key, manifest.store.mantissa_bits if manifest.store else None)
+    store = manifest.store
+    arrays = CollectionWriter(out_dir).unit_arrays(unit.key, store.mantissa_bits if store else None,
+                                                   store.spectral_basis if store else None)
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     field = manifest.reference_grid.field
     env = unit.environment

@@ -154,9 +154,19 @@ class StoreSettings(_Strict):
     """How radiance is stored (``metricscenes.writer.UnitArrays.write_radiance``). Without ``store``
     every value is stored exactly (lossless)."""
 
-    mantissa_bits: Int = Field(
-        ge=1, le=22, description="float32 mantissa bits kept (of 23), rounded to nearest (BitRound): relative "
+    mantissa_bits: Int | None = Field(
+        None, ge=1, le=22, description="float32 mantissa bits kept (of 23), rounded to nearest (BitRound): relative "
         "error at most 2^-(mantissa_bits+1); see docs/performance.md, 'Store size', for the width to choose")
+    spectral_basis: Int | None = Field(
+        None, ge=5, le=31, description="K: each radiance array stored as K coefficients per pixel on K basis "
+        "spectra that hold the IMX363's R, G, B channels and CIE Y exactly (metricscenes.spectral_basis); "
+        "see docs/performance.md, 'A spectral basis per array'")
+
+    @model_validator(mode="after")
+    def _says_something(self):
+        if self.mantissa_bits is None and self.spectral_basis is None:
+            raise ValueError("set mantissa_bits and/or spectral_basis, or leave store out (lossless, 31 bands)")
+        return self
 
 
 class IlluminanceSweep(_Strict):
@@ -335,7 +345,8 @@ def canonical_sha256(data) -> str:
 # form), omitted from the hash while unset so that every earlier manifest keeps its
 # sha256 (pinned by protocols and collections).
 HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "inset_feather"),
-                        ("render", "ground_to_horizon"), ("render", "frame_divisor"))
+                        ("render", "ground_to_horizon"), ("render", "frame_divisor"), ("store", "mantissa_bits"),
+                        ("store", "spectral_basis"))
 
 
 def manifest_sha256(data: dict) -> str:

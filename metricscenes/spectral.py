@@ -6,10 +6,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 WAVELENGTHS_NM: np.ndarray = np.arange(400.0, 701.0, 10.0)
 """Band centres in nm, shape (31,)."""
+
+SENSOR_DATA_DIR = Path(__file__).parent / "data"
+"""Packaged sensor spectra (``imx363_qe.csv``: the IMX363's colour-filter QE x IR cut), read by
+the store's spectral basis (:mod:`metricscenes.spectral_basis`) and the benchmark's cameras."""
 
 BAND_WIDTH_NM: float = 10.0
 RADIANCE_UNITS = "W sr-1 m-2 nm-1"

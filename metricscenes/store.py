@@ -28,7 +28,10 @@ what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
 
 Codecs (:mod:`metricscenes.writer`): radiance is stored losslessly with zarr v3 core
 codecs unless the manifest asks for ``store: {mantissa_bits: N}``; zarr reads each array's
-chain from its ``zarr.json``, so collections written with older chains read the same.
+chain from its ``zarr.json``, so collections written with older chains read the same. With
+``store: {spectral_basis: K}`` a radiance array holds K coefficients per pixel and its
+``spectral_basis`` attribute the K basis spectra; :func:`read_checked` hands back the
+decoded 31 bands (:mod:`metricscenes.spectral_basis`), so no reader sees the difference.
 
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
@@ -55,6 +58,7 @@ from metricscenes.manifest import (
 )
 from metricscenes.radiance import RadianceLayer, SpectralScene, on_grid_of
 from metricscenes.records import ResolvedManifest, resolved_content_sha256
+from metricscenes.spectral_basis import decode
 
 RADIANCE_STORE = "radiance.zarr"
 GROUNDTRUTH_FILE = "groundtruth.json"
@@ -116,6 +120,15 @@ def read_checked(root: Path, group, path: str, expected: str | None, label: str)
         attrs = dict(node.attrs)
     except Exception as exc:  # zstd, numcodecs and zarr raise many types for a damaged chunk
         raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
+    if "spectral_basis" in attrs:  # K coefficients per pixel: the radiance is decoded (store.spectral_basis)
+        try:
+            basis = np.asarray(attrs["spectral_basis"], dtype=np.float64)
+        except (TypeError, ValueError):
+            basis = None
+        bands = len(attrs.get("wavelengths_nm") or ())
+        if basis is None or basis.ndim != 2 or data.ndim != 3 or basis.shape != (data.shape[-1], bands):
+            raise CollectionError(f"{label}: {path} is unreadable (its spectral_basis does not fit its coefficients)")
+        data = decode(data, basis.T)
     if expected is not None and fingerprint not in _CHECKED:
         if array_sha256(data) != expected:
             has_chunk = any(name != "zarr.json" for name, *_ in fingerprint[1:-1])
@@ -123,6 +136,12 @@ def read_checked(root: Path, group, path: str, expected: str | None, label: str)
                                   + ("" if has_chunk else " (its chunk is missing)"))
         _CHECKED.add(fingerprint)
     return data, attrs
+
+
+def _radiance_shape(arr) -> tuple[int, int, int]:
+    """(rows, cols, bands) of a radiance array as a reader gets it, from its metadata (an array
+    stored through a spectral basis holds K coefficients per pixel, not its bands)."""
+    return (*arr.shape[:2], len(arr.attrs.get("wavelengths_nm", ())) or arr.shape[2])
 
 
 def _extent(attrs: dict, label: str, path: str) -> TanExtent:
@@ -360,7 +379,7 @@ class Collection:
             path = f"{kind}/{unit}/{groups[0]}"
             arr = self._node(path, scene_id)
             extent = _extent(dict(arr.attrs), f"{self.root}: scene {scene_id}", path)
-            total = np.zeros(arr.shape, dtype=np.float32)
+            total = np.zeros(_radiance_shape(arr), dtype=np.float32)
         return RadianceLayer(total, extent)
 
     def _node(self, path: str, scene_id: str):
@@ -417,7 +436,7 @@ class Collection:
             arr = self._node(path, scene_id)
             extent = _extent(dict(arr.attrs), f"{self.root}: scene {scene_id}", path)
             rows, cols = arr.shape[:2]
-            out.append({"layer": name, "extent_tan": extent.as_tuple(), "shape": arr.shape,
+            out.append({"layer": name, "extent_tan": extent.as_tuple(), "shape": _radiance_shape(arr),
                         "mrad_per_px": (1e3 * extent.width / cols, 1e3 * extent.height / rows)})
         return out
 

@@ -88,10 +88,12 @@ class UnitArrays:
     per light group (``<kind>/<unit>/<light_group>``) and, for an inset, the car's mask
     (``masks/<unit>``). :attr:`sha256` collects what was written, for the unit's record."""
 
-    def __init__(self, root: str | Path, unit: str, mantissa_bits: int | None = None):
+    def __init__(self, root: str | Path, unit: str, mantissa_bits: int | None = None,
+                 spectral_basis: int | None = None):
         self.root = Path(root)
         self.unit = unit
         self.mantissa_bits = mantissa_bits  # the manifest's store.mantissa_bits; None: lossless
+        self.spectral_basis = spectral_basis  # store.spectral_basis: K basis spectra per array; None: 31 bands
         self.sha256: dict[str, str] = {}
 
     def write_radiance(self, kind: str, light_group: str, cube: np.ndarray, extent: TanExtent,
@@ -99,31 +101,39 @@ class UnitArrays:
         """Write one radiance cube as a single-chunk zarr array (:data:`RADIANCE_COMPRESSORS`);
         return the sha256 of the values stored.
 
-        With ``mantissa_bits`` the values are rounded first (:func:`round_mantissa`), so the
-        sha256 is that of the rounded values, and the array's ``mantissa_bits`` attribute
-        records the width."""
+        With ``spectral_basis`` K the cube is stored as K coefficients per pixel
+        (:mod:`metricscenes.spectral_basis`), its basis spectra in the array's
+        ``spectral_basis`` attribute (K lists of 31). With ``mantissa_bits`` the stored values
+        are rounded (:func:`round_mantissa`) and the ``mantissa_bits`` attribute records the
+        width. The sha256 is that of the values a reader gets back (rounded, decoded)."""
         import zarr
 
+        from metricscenes import spectral_basis
+
         cube = np.ascontiguousarray(cube, dtype=np.float32)
+        basis = None if self.spectral_basis is None else spectral_basis.basis_for(cube, self.spectral_basis)
+        stored = cube if basis is None else spectral_basis.encode(cube, basis)
         if self.mantissa_bits is not None:
-            cube = round_mantissa(cube, self.mantissa_bits)
+            stored = round_mantissa(stored, self.mantissa_bits)
         attrs = {
             "units": RADIANCE_UNITS,
             "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
             "extent_tan": list(extent.as_tuple()),
             "light_group": light_group,
             **({} if self.mantissa_bits is None else {"mantissa_bits": self.mantissa_bits}),
+            **({} if basis is None else {"spectral_basis": basis.T.tolist()}),
             **(extra_attrs or {}),
         }
         path = f"{kind}/{self.unit}/{light_group}"
         arr = zarr.create_array(
-            store=str(self.root / RADIANCE_STORE), name=path, shape=cube.shape,
-            dtype="float32", chunks=cube.shape, dimension_names=DIMENSIONS, attributes=attrs,
-            compressors=RADIANCE_COMPRESSORS if cube.nbytes <= BLOSC_MAX_BYTES else ZARR_DEFAULT_COMPRESSORS,
+            store=str(self.root / RADIANCE_STORE), name=path, shape=stored.shape, dtype="float32", chunks=stored.shape,
+            dimension_names=DIMENSIONS if basis is None else (*DIMENSIONS[:2], spectral_basis.DIMENSION),
+            attributes=attrs,
+            compressors=RADIANCE_COMPRESSORS if stored.nbytes <= BLOSC_MAX_BYTES else ZARR_DEFAULT_COMPRESSORS,
             overwrite=True, config=WRITE_CONFIG,
         )
-        arr[...] = cube
-        self.sha256[path] = array_sha256(cube)
+        arr[...] = stored
+        self.sha256[path] = array_sha256(stored if basis is None else spectral_basis.decode(stored, basis))
         return self.sha256[path]
 
     def write_mask(self, mask: np.ndarray, extent: TanExtent) -> str:
@@ -160,10 +170,10 @@ class CollectionWriter:
         with collection_lock(self.root, notice=notice):
             yield self
 
-    def unit_arrays(self, unit: str, mantissa_bits: int | None = None) -> UnitArrays:
-        """The writer of unit ``unit``'s arrays (``mantissa_bits``: the manifest's
-        ``store.mantissa_bits``; None: lossless)."""
-        return UnitArrays(self.root, unit, mantissa_bits)
+    def unit_arrays(self, unit: str, mantissa_bits: int | None = None, spectral_basis: int | None = None) -> UnitArrays:
+        """The writer of unit ``unit``'s arrays (``mantissa_bits``, ``spectral_basis``: the
+        manifest's ``store`` settings; None: lossless, 31 bands)."""
+        return UnitArrays(self.root, unit, mantissa_bits, spectral_basis)
 
     # --- stamps ------------------------------------------------------------------------
     def prepare(self, manifest: Manifest, variant: str) -> None:

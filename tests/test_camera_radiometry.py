@@ -13,7 +13,7 @@ from metricscenes.radiance import SpectralScene
 from metricscenes.spectral import WAVELENGTHS_NM
 
 H_J_S, C_M_S = 6.62607015e-34, 299792458.0
-QE_CSV = Path(__file__).resolve().parents[1] / "benchmark" / "camera" / "data" / "imx363_qe.csv"
+QE_CSV = Path(__file__).resolve().parents[1] / "metricscenes" / "data" / "imx363_qe.csv"
 
 
 def _hand_electrons(radiance, f_number, pixel_um, exposure_s, transmittance=1.0):

@@ -107,13 +107,14 @@ def test_unknown_illuminant_is_refused_and_known_ones_pass(tmp_path):
 def test_qe_user_file_is_read_beside_the_spec_file(tmp_path, monkeypatch):
     import numpy as np
 
-    from benchmark.camera import DATA_DIR
     from benchmark.camera.calibration import color_matrix
     from benchmark.camera.sensor import effective_qe
 
     folder = tmp_path / "mycam"
     (folder / "data").mkdir(parents=True)
-    lines = (DATA_DIR / "imx363_qe.csv").read_text().splitlines()
+    from metricscenes.spectral import SENSOR_DATA_DIR
+
+    lines = (SENSOR_DATA_DIR / "imx363_qe.csv").read_text().splitlines()
     halved = [lines[0]] + [",".join([row.split(",")[0]] + [f"{float(v) / 2:.6g}" for v in row.split(",")[1:4]]
                                     + row.split(",")[4:]) for row in lines[1:]]
     (folder / "data" / "half_qe.csv").write_text("\n".join(halved) + "\n")

@@ -43,3 +43,33 @@ def test_a_basis_that_spans_the_signal_loses_nothing_and_a_small_one_does(spectr
     # truth than A, and Y keeps less noise.
     assert nearer < 0.95 and kept < 0.95
     assert losses[1][0] > losses[2][0] > 0.3  # one or two of the three spectra left out
+
+
+def test_the_held_spectra_to_compare(spectral_basis):
+    from metricscenes import spectral_basis as store_basis
+    from metricscenes.spectral import WAVELENGTHS_NM
+
+    w = np.asarray(WAVELENGTHS_NM, float)
+    np.testing.assert_array_equal(spectral_basis.held_spectra(w, "imx363+y"), store_basis.held_spectra(w))
+    xyz = spectral_basis.held_spectra(w, "xyz")
+    assert xyz.shape == (31, 3) and np.argmax(xyz[:, 1]) == list(w).index(560.0)  # y-bar peaks at 555 nm
+    assert spectral_basis.held_spectra(w, "none").shape == (31, 0)
+    a, _ = rank3_pair(0.2)
+    v = store_basis.basis_for(a, 3, spectral_basis.held_spectra(w, "none"))  # principal spectra alone
+    np.testing.assert_allclose(v.T @ v, np.eye(3), atol=1e-10)
+
+
+def test_the_held_basis_completes_with_the_data_and_stores_fewer_bytes(spectral_basis):
+    from metricscenes.spectral import WAVELENGTHS_NM
+    from metricscenes.spectral_basis import basis_for
+
+    held = spectral_basis.held_spectra(np.asarray(WAVELENGTHS_NM, float))
+    a, _ = rank3_pair(0.0)
+    v = basis_for(a, 7, held)  # 4 held + 3: the data's span is then inside
+    back, coefficient_bytes, band_bytes = spectral_basis.stored_projection(a, v, None)
+    np.testing.assert_allclose(back, a, rtol=1e-5, atol=1e-6 * a.max())
+    noisy, _ = rank3_pair(0.2)  # incompressible mantissas: bytes in proportion to the values kept
+    _, coefficient_bytes, band_bytes = spectral_basis.stored_projection(noisy, v, None)
+    assert 0.8 * 7 / 31 < coefficient_bytes / band_bytes < 1.2 * 7 / 31
+    rounded, _, _ = spectral_basis.stored_projection(a, v, 8)
+    assert 0 < np.abs(rounded - a).max() < 2**-6 * np.abs(a).max()

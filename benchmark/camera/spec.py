@@ -45,6 +45,7 @@ from metricscenes.geometry import (
     REFERENCE_FOCAL_LENGTH_MM,
     TanExtent,
 )
+from metricscenes.spectral import SENSOR_DATA_DIR
 
 _STRICT = ConfigDict(extra="forbid", frozen=True)
 
@@ -54,7 +55,9 @@ IMX363_ISO_UNITY_GAIN = 55.0
 """ISO at which the IMX363's analog gain is 1 (ISETCam: "for Pixel 4: ISO55")."""
 
 PACKAGE_DATA_DIR = Path(__file__).parent / "data"
-"""Where packaged spectral data (``imx363_qe.csv``) live (``registry.DATA_DIR``)."""
+"""Where the packaged camera specs live (``registry.DATA_DIR``); packaged QE files are
+metricscenes' (``metricscenes.spectral.SENSOR_DATA_DIR``: the store's spectral basis holds
+the IMX363's channels)."""
 
 MAX_CAPTURE_GIB = 4.0
 """A spec whose one capture needs more memory than this (estimate) is refused."""
@@ -89,7 +92,7 @@ def packaged_qe(name: str) -> Path | None:
     """The packaged QE file called ``name`` (a bare file name), or None."""
     if "/" in name:
         return None
-    path = PACKAGE_DATA_DIR / name
+    path = SENSOR_DATA_DIR / name
     return path if path.is_file() else None
 
 
@@ -136,7 +139,7 @@ class SensorSpec(BaseModel):
     active_height_mm: float = Field(REFERENCE_ACTIVE_HEIGHT_MM, gt=0.0, le=50.0)
     cfa: Literal["RGGB"] = "RGGB"
     qe: str = Field("imx363_qe.csv", min_length=1, max_length=255)
-    """Packaged CSV name (``benchmark/camera/data``), else a relative path from the spec
+    """Packaged CSV name (``metricscenes/data``), else a relative path from the spec
     file's folder (no absolute path, no ``..``); columns
     ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``."""
     fill_factor: float = Field(1.0, gt=0.0, le=1.0)
