@@ -16,7 +16,7 @@ per band can still tell apart.
 
 Measured (benchmarks/spectral_basis.py ``--held``; docs/performance.md, "A spectral basis per
 array"): with K = 8, noise-free captures of a scene stored through the basis differ from the
-render's by 1-4 % of the render's own noise for cam12, cam01 and cam08, day and night, and
+render's by 1-8 % of the render's own noise for cam12, cam01 and cam08, day and night, and
 the array takes about 0.3 of the bytes. A sensor with other channels is not held: with
 CIE x-bar, y-bar, z-bar held instead, the same cameras see 40 % of the render noise.
 """

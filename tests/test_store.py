@@ -19,7 +19,7 @@ from conftest import REPO, SMOKE_MANIFEST
 PUBLISHED_SHA256 = {
     "smoke": "a8ca4cecf92284ca884223b2777fe51db0c2849219f857491eed583d165a5507",
     "quick": "c6ffcfba3035d5c7b5c3daf4a89328c9cf8e1ae91529fb7d00272840f112652e",
-    "metric-300": "3c72a1dfc04a7c4a2e0616e0351cceb556b334e17fd304d9246f8c7cfcf0dbab",
+    "metric-300": "81b3566eaf890008554219edf9f9ab4694a08c819179712ffde3526648d7a46f",
 }
 
 
