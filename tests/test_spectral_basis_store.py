@@ -51,6 +51,8 @@ def test_a_collection_through_a_basis_reads_31_bands_identically_with_one_or_two
     from metricscenes.generate import generate
     from metricscenes.store import Collection, CollectionError
 
+    # Two render threads against one: the 100 m inset (30 x 34 px) has fewer 32 px blocks than
+    # threads, where Mitsuba's own block size would change with the thread count (render.BLOCK_SIZE_PX).
     one = generate(parse_manifest(TINY), tmp_path / "one", workers=1)
     two = generate(parse_manifest(TINY), tmp_path / "two", workers=2)
     files = sorted(p.relative_to(one) for p in one.rglob("*") if p.is_file() and "progress" not in p.parts)
