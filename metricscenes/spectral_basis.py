@@ -18,7 +18,8 @@ Measured (benchmarks/spectral_basis.py ``--held``; docs/performance.md, "A spect
 array"): with K = 8, noise-free captures of a scene stored through the basis differ from the
 render's by 1-8 % of the render's own noise for cam12, cam01 and cam08, day and night, and
 the array takes about 0.3 of the bytes. A sensor with other channels is not held: with
-CIE x-bar, y-bar, z-bar held instead, the same cameras see 40 % of the render noise.
+CIE x-bar, y-bar, z-bar held instead, the same cameras see up to about 40 % of the render
+noise.
 """
 
 from __future__ import annotations
@@ -57,10 +58,10 @@ def basis_for(cube: np.ndarray, rank: int, held: np.ndarray | None = None) -> np
     if not q.shape[1] < rank <= cube.shape[-1]:
         raise ValueError(f"store.spectral_basis: {rank} must exceed the {q.shape[1]} held spectra "
                          f"and be at most the {cube.shape[-1]} bands")
-    rows, cols = (max(n // BLOCK_PX, 1) * BLOCK_PX for n in cube.shape[:2])
-    if cube.shape[0] >= BLOCK_PX and cube.shape[1] >= BLOCK_PX:
-        cube = cube[:rows, :cols].astype(np.float64).reshape(rows // BLOCK_PX, BLOCK_PX, cols // BLOCK_PX, BLOCK_PX, -1)
-        cube = cube.mean(axis=(1, 3))
+    if min(cube.shape[:2]) >= BLOCK_PX:  # block means (an array smaller than a block: its pixels)
+        rows, cols = (n // BLOCK_PX for n in cube.shape[:2])
+        cube = cube[: rows * BLOCK_PX, : cols * BLOCK_PX].astype(np.float64)
+        cube = cube.reshape(rows, BLOCK_PX, cols, BLOCK_PX, -1).mean(axis=(1, 3))
     x = cube.reshape(-1, cube.shape[-1]).astype(np.float64)
     length = np.linalg.norm(x, axis=1)
     lit = length > 1e-6 * length.max() if length.size and length.max() > 0 else np.zeros(len(x), bool)
