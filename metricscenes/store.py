@@ -211,6 +211,7 @@ class Collection:
         for ann in groundtruth["annotations"]:
             self._boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
         self._zarr = None
+        self._plate_mix: tuple[tuple, RadianceLayer] | None = None  # the last plate mixed, and its key
         # The light groups of each plate, inset and frame, as recorded (sorted: float sums
         # are not associative); a recorded array that is absent is an error, not a zero.
         self._recorded: dict[str, list[str]] = {}
@@ -365,11 +366,18 @@ class Collection:
             if not required:
                 return None
             raise CollectionError(f"{self.root}: scene {scene_id}: {kind}/{unit} has no arrays in {RESOLVED_MANIFEST_FILE}")
+        lit = [g for g in groups if weights.get(g, 0.0) != 0.0]
+        if not lit and not required:  # a frame whose lamps are off adds nothing
+            return None
+        key = None
+        if kind == "plates":  # one plate serves its environment's scenes, read in turn: mixed once
+            key = (unit, tuple((g, weights[g]) for g in lit),
+                   tuple(_fingerprint(self.root, f"{kind}/{unit}/{g}") for g in lit))  # a changed file is read again
+            if self._plate_mix is not None and self._plate_mix[0] == key:
+                return self._plate_mix[1]
         total, extent = None, None
-        for light_group in groups:
-            w = weights.get(light_group, 0.0)
-            if w == 0.0:
-                continue
+        for light_group in lit:
+            w = weights[light_group]
             path = f"{kind}/{unit}/{light_group}"
             data, attrs = self._read(path, scene_id)
             extent = _extent(attrs, f"{self.root}: scene {scene_id}", path)
@@ -380,7 +388,11 @@ class Collection:
             arr = self._node(path, scene_id)
             extent = _extent(dict(arr.attrs), f"{self.root}: scene {scene_id}", path)
             total = np.zeros(_radiance_shape(arr), dtype=np.float32)
-        return RadianceLayer(total, extent)
+        layer = RadianceLayer(total, extent)
+        if key is not None:
+            total.flags.writeable = False  # shared by the scenes that reuse it
+            self._plate_mix = (key, layer)
+        return layer
 
     def _node(self, path: str, scene_id: str):
         """An array's metadata (shape, attributes) without reading its data."""

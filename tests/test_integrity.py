@@ -257,3 +257,24 @@ def test_generate_does_not_trust_a_progress_record_box(smoke_collection, smoke_m
     generate(smoke_manifest, root, notice=notices.append)
     assert [line.split()[1] for line in notices] == ["env000-d100m"], notices
     assert (root / "groundtruth.json").read_bytes() == (smoke_collection / "groundtruth.json").read_bytes()
+
+
+def test_a_plate_is_mixed_once_for_its_scenes_and_read_again_once_changed(smoke_collection, tmp_path):
+    import numpy as np
+
+    root = _copy(smoke_collection, tmp_path)
+    c = Collection.open(root)
+    first = c.radiance("env000-d025m", "day").layers[0].radiance
+    again = c.radiance("env000-d050m", "day").layers[0].radiance  # the same environment and condition
+    assert again is first and not first.flags.writeable  # shared, so no reader may write into it
+    np.testing.assert_array_equal(first, Collection.open(root).radiance("env000-d050m", "day").layers[0].radiance)
+    night = c.radiance("env000-d050m", "night").layers[0].radiance  # other weights (and the car's lamps)
+    assert night is not first
+    np.testing.assert_array_equal(night, Collection.open(root).radiance("env000-d050m", "night").layers[0].radiance)
+    c.radiance("env001-d025m", "day")  # env001's day plate is now the one kept
+    chunk = _chunk(root, "plates/env001/sky_day")
+    data = bytearray(chunk.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    chunk.write_bytes(bytes(data))
+    with pytest.raises(CollectionError, match="plates/env001/sky_day does not match its sha256"):
+        c.radiance("env001-d050m", "day")  # its file changed: read again, and checked
