@@ -3,6 +3,16 @@ of the signal K basis spectra keep, against the render's own noise.
 
     PYTHONPATH=. python benchmarks/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
         [--light-groups sky_day] [--ranks 3 4 6 8 10]
+    PYTHONPATH=. python benchmarks/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
+        --ranks 6 8 10 --held day night [--hold imx363+y|xyz|none]
+
+``--held``: the store's basis (``store.spectral_basis``: the sensor's channels and Y held,
+:mod:`metricscenes.spectral_basis`) judged by cameras instead of Y: the scene under each
+condition from render A, from render B and from A stored through the basis (coefficients
+rounded as the store does), captured noise-free by cam12, cam01 and cam08 at A's exposure;
+the table gives the render noise (A against B) and the basis's loss (A against P A) over
+the shot noise, as ``render_noise.py`` does. ``--hold`` swaps the held spectra for CIE
+x-bar, y-bar, z-bar or none (the principal spectra alone), to see what holding them buys.
 
 A basis stores a (rows, cols, 31) array as (rows, cols, K) coefficients and 31 x K basis
 spectra: K/31 of the values (before the codecs). Here the basis of an array is the K
