@@ -156,6 +156,7 @@ class RunResults(Record):
     camera_geometry: CameraGeometry | None = None
     subset: Subset | None = None
     exposure_short_s: dict[str, float] | None = None  # hdr only: the short frames per scene id
+    captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
 
     def ap_curve(self) -> tuple[list[float], list[float]]:
         """(distances in m, AP) of ``per_distance``: the points OD50 is read from."""

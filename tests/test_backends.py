@@ -112,18 +112,25 @@ def _sweep_files(folder: Path) -> dict[str, bytes]:
     return files
 
 
+def _small_cameras(folder: Path) -> list:
+    """Two cameras of 240 x 135 and 320 x 180 px: a sweep of the tiny collection in seconds."""
+    from benchmark.camera import load_camera
+
+    cameras = []
+    for name, f_number, pixel_um in (("small-a", 2.0, 11.2), ("small-b", 4.0, 8.4)):
+        spec = folder / f"{name}.yaml"
+        spec.write_text(f"name: {name}\noptics: {{f_number: {f_number}}}\nsensor: {{pixel_um: {pixel_um}}}\n")
+        cameras.append(load_camera(spec))
+    return cameras
+
+
 @pytest.mark.slow
 def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
     require_model("yolov5n-dynamic.onnx")
-    from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
     from benchmark.experiments.sweep import sweep
 
-    cameras = []
-    for name, f_number, pixel_um in (("small-a", 2.0, 11.2), ("small-b", 4.0, 8.4)):  # 240 x 135 and 320 x 180 px
-        spec = tmp_path / f"{name}.yaml"
-        spec.write_text(f"name: {name}\noptics: {{f_number: {f_number}}}\nsensor: {{pixel_um: {pixel_um}}}\n")
-        cameras.append(load_camera(spec))
+    cameras = _small_cameras(tmp_path)
     detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
     options = dict(n_resamples=20, mtf_source="analytic")
     serial = sweep(serial_collection, cameras, ["day"], detector, tmp_path / "serial", **options)
@@ -132,6 +139,51 @@ def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
     files = _sweep_files(tmp_path / "serial")
     assert any(name.endswith(".png") for name in files) and "runs/small-b-day/od50.json" in files
     assert _sweep_files(tmp_path / "pooled") == files
+
+
+@pytest.mark.slow
+def test_a_sweep_on_another_sweeps_captures_detects_the_same(serial_collection, tmp_path, monkeypatch):
+    """--captures-from: a 640 sweep that detects on a native sweep's images writes what a 640
+    sweep that simulates the cameras writes, without simulating them; a capture of another
+    seed is not taken, and a damaged image is a one-line error."""
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.detectors import load_detector
+    from benchmark.experiments import run as run_module
+    from benchmark.experiments.sweep import sweep
+    from metricscenes.store import Collection
+
+    cameras = _small_cameras(tmp_path)
+    options = dict(n_resamples=20, mtf_source="analytic")
+    native = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
+    at_640 = load_detector("yolov5n-dynamic", input_size=640, model_dir=model_dir())
+    sweep(serial_collection, cameras, ["day"], native, tmp_path / "native", **options)
+    fresh = sweep(serial_collection, cameras, ["day"], at_640, tmp_path / "fresh", **options)
+
+    def no_camera(*args, **kwargs):
+        raise AssertionError("the camera was simulated")
+
+    monkeypatch.setattr("benchmark.camera.pipeline.simulate", no_camera)
+    reused = sweep(serial_collection, cameras, ["day"], at_640, tmp_path / "reused", captures_from=tmp_path / "native",
+                   **options)
+    assert reused.equals(fresh)
+    files = _sweep_files(tmp_path / "reused")
+    for name in [n for n in files if n.endswith("results.json")]:
+        results = json.loads(files.pop(name))
+        assert results.pop("captures_from") == str(tmp_path / "native" / Path(name).parent)
+        assert json.loads(_sweep_files(tmp_path / "fresh")[name]) == results
+    assert {k: v for k, v in _sweep_files(tmp_path / "fresh").items() if not k.endswith("results.json")} == files
+
+    collection = Collection.open(serial_collection)
+    with pytest.raises(ValueError, match="another camera, condition, collection or seed"):
+        run_module.read_captures(tmp_path / "native" / "runs" / "small-a-day", cameras[0], "day", collection, seed=1)
+    image = next((tmp_path / "native" / "runs" / "small-a-day" / "images").iterdir())
+    image.write_bytes(image.read_bytes()[:100])
+    with pytest.raises(ValueError, match=r"^captures .*: unreadable image"):
+        run_module.run_camera(collection, cameras[0], "day", at_640, tmp_path / "damaged",
+                              captures=tmp_path / "native" / "runs" / "small-a-day")
+    assert not (tmp_path / "damaged").exists()
+    with pytest.raises(ValueError, match="is the sweep folder itself"):
+        sweep(serial_collection, cameras, ["day"], at_640, tmp_path / "native", captures_from=tmp_path / "native")
 
 
 # --- the backends themselves ---------------------------------------------------------------

@@ -118,6 +118,9 @@ def sweep(
     class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
     workers: Annotated[int, typer.Option(min=1, help="processes running camera × condition runs in parallel")] = 1,
     scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
+    captures_from: Annotated[Optional[Path], typer.Option(
+        help="another sweep folder on this collection: detect on its runs' camera images where they match "
+             "(same camera, condition and seed) instead of simulating the camera again")] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
     from benchmark.experiments import sweep as sweep_module
@@ -157,7 +160,7 @@ def sweep(
 
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
                                progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy,
-                               workers=workers, scheduler=scheduler)
+                               workers=workers, scheduler=scheduler, captures_from=captures_from)
     except (ValueError, DetectorError, CollectionError, BackendError, OSError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     _, od50_table = sweep_module.load_sweep(out)

@@ -12,6 +12,12 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
   mapped onto the camera's window of the field: :func:`camera_geometry`);
 - ``images/<scene>.png``: the camera's sRGB images (optional).
 
+The camera's images depend on the camera, condition, collection and seed only
+(:func:`capture_key`), not on the detector: a run given ``captures`` (an earlier run folder
+of the same capture key, with its images) detects on those images and skips the radiance and
+the camera, with the same detections as a run that simulates them (another detector, input
+size or class map on the same captures: ``benchmark sweep --captures-from``).
+
 A run on a :class:`CollectionSubset` (``--environments 0-2,5 --distances 25,50``, a quick
 try) records ``subset`` in results.json; `benchmark submit` refuses it and a sweep never
 reuses it as a full run.
@@ -95,6 +101,66 @@ def _geometry_record(camera, field, window) -> dict | None:
         return None
     return {"hfov_deg": round(camera.hfov_deg, 6), "vfov_deg": round(camera.vfov_deg, 6),
             "window_tan": list(window.as_tuple()), "collection_fov_deg": [round(v, 6) for v in fov_deg(field)]}
+
+
+def capture_key(camera, condition: str, collection, seed: int) -> dict:
+    """What makes two runs' camera images interchangeable: camera spec sha256, condition,
+    collection manifest sha256, seed, and the camera's geometry and the collection subset
+    where present (the detector is not part of it)."""
+    key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
+           "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
+    geometry = camera_geometry(collection, camera)
+    if geometry is not None:
+        key["camera_geometry"] = geometry
+    subset = getattr(collection, "subset", None)
+    if subset:
+        key["subset"] = subset
+    return key
+
+
+def results_capture_key(results: RunResults) -> dict:
+    """The :func:`capture_key` a ``results.json`` was made with."""
+    key = {"camera_spec_sha256": results.camera.spec_sha256, "condition": results.condition,
+           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed}
+    if results.camera_geometry is not None:
+        key["camera_geometry"] = results.camera_geometry.model_dump()
+    if results.subset is not None:
+        key["subset"] = results.subset.model_dump()
+    return key
+
+
+def read_captures(captures, camera, condition: str, collection, seed: int) -> RunResults:
+    """The results of the run folder ``captures`` if its images can stand for this run's
+    camera (same :func:`capture_key`, an image for every scene); ValueError (one line) if not."""
+    from benchmark.result_files import ResultsFileError, read_results
+
+    captures = Path(captures)
+    try:
+        results = read_results(captures / "results.json")
+    except (OSError, ResultsFileError) as exc:
+        raise ValueError(f"captures {captures}: no finished run there ({str(exc).splitlines()[0]})") from None
+    if results_capture_key(results) != capture_key(camera, condition, collection, seed):
+        raise ValueError(f"captures {captures}: made with another camera, condition, collection or seed")
+    missing = [s.scene_id for s in collection.scenes() if not (captures / "images" / f"{s.scene_id}.png").is_file()]
+    if missing:
+        raise ValueError(f"captures {captures}: no image of {len(missing)} scene(s), e.g. {missing[0]}.png")
+    return results
+
+
+def _captured_image(captures: Path, scene_id: str, camera) -> np.ndarray:
+    """The 8-bit sRGB image a run saved of ``scene_id`` (PNG: the very array it detected on)."""
+    from PIL import Image
+
+    path = captures / "images" / f"{scene_id}.png"
+    try:
+        with Image.open(path) as image:
+            rgb8 = np.asarray(image)
+    except OSError as exc:
+        raise ValueError(f"captures {path}: unreadable image ({str(exc).splitlines()[0]})") from None
+    if rgb8.dtype != np.uint8 or rgb8.shape != (camera.height_px, camera.width_px, 3):
+        raise ValueError(f"captures {path}: {rgb8.shape} {rgb8.dtype} image, the camera makes "
+                         f"({camera.height_px}, {camera.width_px}, 3) uint8")
+    return rgb8
 
 
 def _compact(values) -> str:
@@ -224,11 +290,14 @@ def sha256_bytes(data: bytes) -> str:
 
 
 def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, seed: int = 0,
-               save_images: bool = True, backend: str = "faster-coco-eval", progress=None) -> RunResults:
+               save_images: bool = True, backend: str = "faster-coco-eval", progress=None,
+               captures: Path | None = None) -> RunResults:
     """Simulate ``camera`` on every scene of ``collection`` under ``condition``, detect, score.
 
-    ``progress`` is an optional callable ``(done, total)``. Returns the results (also
-    written to ``out_dir/results.json``).
+    ``progress`` is an optional callable ``(done, total)``. ``captures``: a finished run
+    folder of the same :func:`capture_key` whose images are detected instead of simulating
+    the camera again (:func:`read_captures`; recorded as ``captures_from``). Returns the
+    results (also written to ``out_dir/results.json``).
 
     Everything is written to a staging folder inside ``out_dir`` first and moved into place
     only when the run succeeded: a damaged scene or a broken model met halfway leaves
@@ -239,12 +308,14 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     out_dir = check_out_dir(out_dir)  # before anything is written
     field = collection_field(collection)
     window = camera_window(camera, field)  # a camera wider than the collection: refused here
+    captured = None if captures is None else read_captures(captures, camera, condition, collection, seed)
     created = [p for p in (out_dir, *out_dir.parents) if not p.exists()]
     out_dir.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out_dir))
     try:
         results = _run_camera(collection, camera, condition, detector, stage, field, window, seed=seed,
-                              save_images=save_images, backend=backend, progress=progress)
+                              save_images=save_images, backend=backend, progress=progress,
+                              captures=None if captures is None else (Path(captures), captured))
         # Into place, one rename a file: images, detections and ground truth, then
         # results.json last (a sweep takes a run folder with its results.json as finished).
         if save_images:
@@ -266,9 +337,10 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
 
 
 def _run_camera(collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
-                save_images: bool, backend: str, progress) -> RunResults:
+                save_images: bool, backend: str, progress, captures: tuple[Path, RunResults] | None) -> RunResults:
     """:func:`run_camera`'s work, writing into ``stage``; ``window`` is the part of the
-    collection's ``field`` the camera samples (and its ground truth follows)."""
+    collection's ``field`` the camera samples (and its ground truth follows); ``captures``:
+    (folder, results) of the run whose images stand for the camera's."""
     from PIL import Image
 
     from benchmark.camera.pipeline import lens_mapping, simulate
@@ -285,18 +357,26 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     exposures: dict[str, float] = {}
     short_exposures: dict[str, float] = {}  # the hdr policy's second frame
     for i, scene in enumerate(scenes):
-        t = time.perf_counter()
-        radiance = collection.radiance(scene.scene_id, condition)
-        timings.add("read_radiance", t)
-        t = time.perf_counter()
-        capture = simulate(radiance, camera, seed=scene_seed(seed, scene.image_id))
-        timings.add("camera", t)
-        exposures[scene.scene_id] = capture.exposure_s
-        if capture.exposure_short_s is not None:
-            short_exposures[scene.scene_id] = capture.exposure_short_s
+        if captures is None:
+            t = time.perf_counter()
+            radiance = collection.radiance(scene.scene_id, condition)
+            timings.add("read_radiance", t)
+            t = time.perf_counter()
+            capture = simulate(radiance, camera, seed=scene_seed(seed, scene.image_id))
+            timings.add("camera", t)
+            rgb8, exposures[scene.scene_id] = capture.rgb8, capture.exposure_s
+            if capture.exposure_short_s is not None:
+                short_exposures[scene.scene_id] = capture.exposure_short_s
+        else:
+            t = time.perf_counter()
+            rgb8 = _captured_image(captures[0], scene.scene_id, camera)
+            exposures[scene.scene_id] = captures[1].exposure_s[scene.scene_id]
+            if captures[1].exposure_short_s is not None:
+                short_exposures[scene.scene_id] = captures[1].exposure_short_s[scene.scene_id]
+            timings.add("read_captures", t)
         t = time.perf_counter()
         # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
-        (found,) = detector.detect([capture.rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
+        (found,) = detector.detect([rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
         timings.add("detect", t)
         for d in found:
             x1, y1, x2, y2 = (float(v) for v in d.box_xyxy)
@@ -307,7 +387,10 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
             })
         if save_images:
             t = time.perf_counter()
-            Image.fromarray(capture.rgb8).save(stage / "images" / f"{scene.scene_id}.png", compress_level=1)
+            if captures is None:
+                Image.fromarray(rgb8).save(stage / "images" / f"{scene.scene_id}.png", compress_level=1)
+            else:
+                shutil.copyfile(captures[0] / "images" / f"{scene.scene_id}.png", stage / "images" / f"{scene.scene_id}.png")
             timings.add("save_images", t)
         if progress:
             progress(i + 1, len(scenes))
@@ -355,6 +438,8 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
         results.subset = Subset(**subset)
     if short_exposures:  # hdr only; exposure_s holds the long frames
         results.exposure_short_s = short_exposures
+    if captures is not None:  # detected on an earlier run's images
+        results.captures_from = str(captures[0])
     (stage / "detections.json").write_bytes(detections_bytes)
     (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
     write_results(stage / "results.json", results)

@@ -77,20 +77,14 @@ def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) 
 
 
 def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
-    """What makes two runs interchangeable (the cache key). A camera that sees a window
-    of the collection's field adds its geometry (runs made before cameras had their own
-    field of view are redone); the registry cameras' keys are unchanged."""
-    from benchmark.experiments.run import camera_geometry
+    """What makes two runs interchangeable (the cache key): what made the camera's images
+    (:func:`benchmark.experiments.run.capture_key`; a camera that sees a window of the
+    collection's field adds its geometry, so runs made before cameras had their own field of
+    view are redone, while the registry cameras' keys are unchanged) and the detector."""
+    from benchmark.experiments.run import capture_key
 
-    key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
-           "model_sha256": detector.sha256, "input_size": str(detector.input_size),
-           "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
-    geometry = camera_geometry(collection, camera)
-    if geometry is not None:
-        key["camera_geometry"] = geometry
-    subset = getattr(collection, "subset", None)
-    if subset:  # a subset run (--environments/--distances) is never reused as a full one, nor the reverse
-        key["subset"] = subset
+    key = {**capture_key(camera, condition, collection, seed),
+           "model_sha256": detector.sha256, "input_size": str(detector.input_size)}
     if getattr(detector, "class_map", None) is not None:  # the same model file read through another class map
         from benchmark.detectors.classmap import class_map_names
 
@@ -100,18 +94,27 @@ def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
 
 def results_key(results: RunResults) -> dict | None:
     """The cache key recorded in a ``results.json`` (None for one that names no detector: never reused)."""
+    from benchmark.experiments.run import results_capture_key
+
     if results.detector is None:
         return None
-    key = {"camera_spec_sha256": results.camera.spec_sha256, "condition": results.condition,
-           "model_sha256": results.detector.sha256, "input_size": str(results.detector.input_size),
-           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed}
-    if results.camera_geometry is not None:
-        key["camera_geometry"] = results.camera_geometry.model_dump()
-    if results.subset is not None:
-        key["subset"] = results.subset.model_dump()
+    key = {**results_capture_key(results),
+           "model_sha256": results.detector.sha256, "input_size": str(results.detector.input_size)}
     if results.detector.class_map is not None:
         key["class_map"] = results.detector.class_map
     return key
+
+
+def captures_for(run_dir: Path, camera, condition: str, collection, seed: int) -> Path | None:
+    """``run_dir`` if its images can stand for this run's camera (its capture key, an image
+    per scene), else None."""
+    from benchmark.experiments.run import read_captures
+
+    try:
+        read_captures(run_dir, camera, condition, collection, seed)
+    except ValueError:
+        return None
+    return run_dir
 
 
 def cached_results(run_dir: Path, key: dict) -> RunResults | None:
@@ -151,14 +154,15 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
 
 
 def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
-                backend: str, n_resamples: int, progress=None) -> tuple[str, str, RunResults]:
+                backend: str, n_resamples: int, progress=None, captures: Path | None = None) -> tuple[str, str, RunResults]:
     """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
     backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
-    other unit touches. Returns (camera name, condition, results)."""
+    other unit touches (``captures``, another sweep's run folder, is only read). Returns
+    (camera name, condition, results)."""
     from benchmark.experiments import run as run_module
 
     results = run_module.run_camera(collection, camera, condition, detector, run_dir, seed=seed,
-                                    save_images=save_images, backend=backend, progress=progress)
+                                    save_images=save_images, backend=backend, progress=progress, captures=captures)
     run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
     return camera.name, condition, results
 
@@ -166,7 +170,8 @@ def compute_run(collection, camera, condition: str, detector, run_dir: Path, see
 def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
           n_resamples: int = BOOTSTRAP_RESAMPLES, progress: Progress | None = None, mtf_source: str = "measured",
           backend: str = "faster-coco-eval", save_images: bool = True,
-          exposure: ExposureSpec | None = None, workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
+          exposure: ExposureSpec | None = None, workers: int = 1, scheduler: str | None = None,
+          captures_from: str | os.PathLike | None = None) -> pd.DataFrame:
     """Run every camera × condition (reusing cached runs); write and return the AP table.
 
     Args:
@@ -188,6 +193,11 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             ``workers`` processes, or dask (``scheduler`` ``local`` or ``tcp://HOST:PORT``).
             The detector is pickled as what builds it and loaded again in each worker. The
             outputs do not depend on these (``results.json`` ``timing_s`` aside).
+        captures_from: another sweep folder on the same collection (another detector or
+            input size): a run whose camera images it holds (same camera, condition,
+            collection and seed; :func:`captures_for`) detects on them instead of simulating
+            the camera again. Same detections either way; ``results.json`` records
+            ``captures_from``.
 
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
@@ -228,6 +238,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             run_name(camera.name, condition, tags[camera.name])
     check_scheduler(scheduler)
     out_dir = run_module.check_out_dir(out_dir)
+    if captures_from is not None and Path(captures_from).resolve() == out_dir.resolve():
+        raise ValueError(f"--captures-from {captures_from} is the sweep folder itself: name another sweep's folder")
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
     n_scenes = len(collection.scenes())
@@ -254,8 +266,15 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         # (a run computed here reports each scene; ``done`` is read when called: the runs before it)
         return (lambda d, t: progress(done + d, total, label)) if progress and in_process else None
 
+    def captures(camera, condition: str) -> Path | None:
+        if captures_from is None:
+            return None
+        return captures_for(Path(captures_from) / run_dirs[camera.name, condition].relative_to(out_dir),
+                            camera, condition, collection, seed)
+
     jobs = [(collection, camera, condition, detector, run_dirs[camera.name, condition], seed, save_images, backend,
-             n_resamples, scene_progress(f"{camera.name} · {condition}")) for camera, condition in todo]
+             n_resamples, scene_progress(f"{camera.name} · {condition}"), captures(camera, condition))
+            for camera, condition in todo]
     with closing(map_units(compute_run, jobs, workers=workers, scheduler=scheduler)) as finished:
         for camera_name, condition, run_results in finished:  # in the order they finish
             results[camera_name, condition] = run_results
