@@ -75,8 +75,10 @@ def synthetic_detections(gt: dict, half_range_m: float, seed: int) -> list[dict]
 
 
 def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0, save_images=True,
-                    backend="faster-coco-eval", progress=None):
-    """Writes the files of a real run; detections from the synthetic detector."""
+                    backend="faster-coco-eval", progress=None, captures=None):
+    """Writes the files of a real run; detections from the synthetic detector (it simulates every
+    camera, so ``captures`` must be None)."""
+    assert captures is None, "fake_run_camera does not read another sweep's captures"
     from PIL import Image, ImageDraw
 
     from benchmark.experiments.run import sha256_bytes
