@@ -16,8 +16,9 @@ twice with metricscenes' own render path, differing only in seed
 another), with only the daylight light group rendered (``--light-group sky_day``: the
 ``day`` condition is ``{sky_day: 1}``). ``--spp`` sets the plates' and insets' spp,
 ``--plate-width``/``--plate-height`` the reference grid (the plates' grid; insets keep
-``inset_pixel_mrad``). ``--collection``: render A must be that collection's array
-(checked by sha256 where the grid and render settings are the collection's).
+``inset_pixel_mrad``). ``--collection``: render A, written as that collection's ``store``
+writes it, must be the collection's array (checked by sha256 where the grid and render
+settings are the collection's).
 
 Each render becomes the scene a run hands the camera (a :class:`SpectralScene`: the
 plate layer, and the inset layer over it at its extent) and goes through the camera's
@@ -211,10 +212,12 @@ def channel_ratios(e_a, e_b, used, cfa: str) -> str:
 
 
 def collection_check(collection, manifest, layers: dict[str, dict[str, Renders]]) -> str:
-    """Whether render A of every array is the collection's array (same sha256): yes / NO;
-    n/a where there is nothing to compare (no collection, another grid or render
-    settings, an array it has not got)."""
+    """Whether render A of every array, written as the collection's ``store`` writes it
+    (rounded, through the basis; ``manifest``, the one rendered here, has no store), is the
+    collection's array (same sha256): yes / NO; n/a where there is nothing to compare (no
+    collection, another grid or render settings, an array it has not got)."""
     from metricscenes.store import array_sha256
+    from metricscenes.writer import read_back, stored_form
 
     if collection is None or (collection.manifest.render, collection.manifest.reference_grid) != (
             manifest.render, manifest.reference_grid):
@@ -222,7 +225,10 @@ def collection_check(collection, manifest, layers: dict[str, dict[str, Renders]]
     recorded = {p: collection.resolved.arrays.get(p) for renders in layers.values() for p in renders}
     if any(sha is None for sha in recorded.values()):
         return "n/a"
-    same = all(array_sha256(r.a) == recorded[p] for renders in layers.values() for p, r in renders.items())
+    store = collection.manifest.store
+    mantissa_bits, basis_k = (None, None) if store is None else (store.mantissa_bits, store.spectral_basis)
+    same = all(array_sha256(read_back(*stored_form(r.a, mantissa_bits, basis_k))) == recorded[p]
+               for renders in layers.values() for p, r in renders.items())
     return "yes" if same else "NO"
 
 

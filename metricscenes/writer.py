@@ -83,6 +83,29 @@ def round_mantissa(values: np.ndarray, mantissa_bits: int) -> np.ndarray:
     return np.asarray(BitRound(keepbits=mantissa_bits).encode(a)).view(np.float32)
 
 
+def stored_form(cube: np.ndarray, mantissa_bits: int | None, spectral_basis_k: int | None
+                ) -> tuple[np.ndarray, np.ndarray | None]:
+    """What :meth:`UnitArrays.write_radiance` stores of ``cube`` with these store settings
+    (the manifest's ``store``; None: lossless, 31 bands): the values (K coefficients per pixel
+    on the cube's basis, or the 31 bands), rounded, and the basis (None for 31 bands)."""
+    from metricscenes import spectral_basis
+
+    cube = np.ascontiguousarray(cube, dtype=np.float32)
+    basis = None if spectral_basis_k is None else spectral_basis.basis_for(cube, spectral_basis_k)
+    stored = cube if basis is None else spectral_basis.encode(cube, basis)
+    if mantissa_bits is not None:
+        stored = round_mantissa(stored, mantissa_bits)
+    return stored, basis
+
+
+def read_back(stored: np.ndarray, basis: np.ndarray | None) -> np.ndarray:
+    """The 31 bands a reader gets back of :func:`stored_form`'s values (what an array's
+    sha256 is of)."""
+    from metricscenes import spectral_basis
+
+    return stored if basis is None else spectral_basis.decode(stored, basis)
+
+
 class UnitArrays:
     """The arrays of one unit of work, written by the process that renders it: its radiance
     per light group (``<kind>/<unit>/<light_group>``) and, for an inset, the car's mask
@@ -110,11 +133,7 @@ class UnitArrays:
 
         from metricscenes import spectral_basis
 
-        cube = np.ascontiguousarray(cube, dtype=np.float32)
-        basis = None if self.spectral_basis is None else spectral_basis.basis_for(cube, self.spectral_basis)
-        stored = cube if basis is None else spectral_basis.encode(cube, basis)
-        if self.mantissa_bits is not None:
-            stored = round_mantissa(stored, self.mantissa_bits)
+        stored, basis = stored_form(cube, self.mantissa_bits, self.spectral_basis)
         attrs = {
             "units": RADIANCE_UNITS,
             "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
@@ -133,7 +152,7 @@ class UnitArrays:
             overwrite=True, config=WRITE_CONFIG,
         )
         arr[...] = stored
-        self.sha256[path] = array_sha256(stored if basis is None else spectral_basis.decode(stored, basis))
+        self.sha256[path] = array_sha256(read_back(stored, basis))
         return self.sha256[path]
 
     def write_mask(self, mask: np.ndarray, extent: TanExtent) -> str:

@@ -59,3 +59,35 @@ def test_fitted_convergence(render_noise):
     alpha, spp = render_noise.fitted_spp([(16, 0.4), (64, 0.4 / 4**0.75)])
     assert alpha == pytest.approx(0.75)
     assert spp == pytest.approx(16 * (0.4 * 3) ** (1 / 0.75))
+
+
+def test_collection_check_compares_render_a_as_the_store_writes_it(render_noise, tmp_path):
+    """On a lossy store (quick: BitRound 8, an 8-spectra basis) render A is the collection's
+    array once written as its store writes it (the manifest rendered has no store); another
+    render is not; other render settings are n/a."""
+    from types import SimpleNamespace
+
+    from conftest import REPO
+    from store_codecs import Renders
+
+    from metricscenes.geometry import TanExtent
+    from metricscenes.manifest import load_manifest
+    from metricscenes.writer import UnitArrays
+
+    quick = load_manifest(REPO / "manifests" / "quick.yaml")
+    rng = np.random.default_rng(0)
+    cube = rng.gamma(2.0, 0.01, size=(24, 32, 31)).astype(np.float32)
+    extent = TanExtent(-0.1, -0.05, 0.1, 0.05)
+    arrays = UnitArrays(tmp_path, "env000", quick.store.mantissa_bits, quick.store.spectral_basis)
+    arrays.write_radiance("plates", "sky_day", cube, extent)
+    collection = SimpleNamespace(manifest=quick, resolved=SimpleNamespace(arrays=arrays.sha256))
+    layers = {"plate": {path: Renders(cube, cube, extent) for path in arrays.sha256}}
+    rendered = quick.model_copy(update={"store": None})
+    assert render_noise.collection_check(collection, rendered, layers) == "yes"
+
+    other = cube.copy()
+    other[0, 0, 0] *= 1.5
+    assert render_noise.collection_check(collection, rendered, {"plate": {p: Renders(other, cube, extent)
+                                                                          for p in arrays.sha256}}) == "NO"
+    finer = rendered.model_copy(update={"render": rendered.render.model_copy(update={"plate_spp": 64})})
+    assert render_noise.collection_check(collection, finer, layers) == "n/a"
