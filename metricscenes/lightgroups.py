@@ -32,6 +32,13 @@ from metricscenes.geometry import CAMERA_HEIGHT_M
 from metricscenes.render import ILLUMINANCE_METER_SPP, RenderError, is_jit_variant, load_scene, with_illuminance_patch
 from metricscenes.spectral import WAVELENGTHS_NM
 
+# The most paths traced in one wavefront. Its state costs about 400 bytes a lane on the LLVM
+# backend (quick's 960 x 540 x 36 spp plate, 18.7 M lanes, peaked at 7.5 GB), so a metric-300
+# plate (1920 x 1080 x 36: 75 M lanes) traced whole would need about 30 GB. A larger window is
+# traced in bands of whole rows. Fixed, not taken from the machine's memory: the bands' seeds
+# are part of what is rendered, so every machine renders the same bytes.
+MAX_WAVEFRONT_LANES = 2**24
+
 
 def _mis_weight(pdf_a, pdf_b):
     """Power heuristic (β = 2), as Mitsuba's path integrator."""
@@ -227,20 +234,40 @@ def render_light_groups(scene, emitter_groups: Mapping[object, int], n_groups: i
         raise RenderError(f"{len(missing)} emitter(s) of the scene belong to no light group")
     sensor = scene.sensors()[0]
     film = sensor.film()
-    window = window or (0, 0, *film.size())
+    x0, y0, cols, rows = window or (0, 0, *film.size())
+    groups = _Groups(emitter_groups, n_groups)
+    bands = WAVELENGTHS_NM.size
+    images = [np.empty((rows, cols, bands), np.float32) for _ in range(n_groups)]
     with dr.suspend_grad():
         film.prepare([])  # (its channels: the bands and a weight)
-        sampler, ray, weight = _window_rays(sensor, window, spp, seed)
-        sums = _trace(scene, sampler, ray, _Groups(emitter_groups, n_groups), max_depth)
-        # One kernel traces the paths; the reductions below read its stored results (left
-        # lazy, each band of each group would re-trace every path in its own kernel).
-        dr.eval(sums, ray.wavelengths, weight)
-        per_group = _band_means(film, sums, ray.wavelengths, weight, spp)
-    bands = WAVELENGTHS_NM.size
-    cols, rows = window[2:]
-    images = [np.stack([np.asarray(c, dtype=np.float32) for c in group], axis=-1).reshape(rows, cols, bands)
-              for group in per_group]
+        for index, (first, count) in enumerate(wavefront_bands(rows, cols * spp)):
+            sampler, ray, weight = _window_rays(sensor, (x0, y0 + first, cols, count), spp, band_seed(seed, index))
+            sums = _trace(scene, sampler, ray, groups, max_depth)
+            # One kernel traces the paths; the reductions below read its stored results (left
+            # lazy, each band of each group would re-trace every path in its own kernel).
+            dr.eval(sums, ray.wavelengths, weight)
+            for image, group in zip(images, _band_means(film, sums, ray.wavelengths, weight, spp)):
+                image[first:first + count] = np.stack([np.asarray(c, dtype=np.float32) for c in group],
+                                                      axis=-1).reshape(count, cols, bands)
+            del sampler, ray, weight, sums  # free this band's wavefront before the next
     return images
+
+
+def wavefront_bands(rows: int, lanes_per_row: int, max_lanes: int | None = None) -> list[tuple[int, int]]:
+    """(first row, rows) of the bands a window of ``rows`` rows is traced in: as many whole
+    rows as fit in ``max_lanes`` lanes (default :data:`MAX_WAVEFRONT_LANES`; at least one
+    row), the last band the rest."""
+    per_band = max(1, (max_lanes or MAX_WAVEFRONT_LANES) // lanes_per_row)
+    return [(first, min(per_band, rows - first)) for first in range(0, rows, per_band)]
+
+
+def band_seed(seed: int, index: int) -> int:
+    """The seed of a window's band ``index``: the unit's own for the first (a window traced in
+    one band renders what it did before bands), then one drawn from (seed, index), so that no
+    band repeats another's random numbers (nor those of the unit seeded seed + 1)."""
+    if index == 0:
+        return seed
+    return int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1)[0])
 
 
 def passes(light_groups: Sequence[str]) -> list[tuple[str, ...]]:
