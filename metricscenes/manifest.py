@@ -42,6 +42,11 @@ illuminance sweep's ``<base>@<level>lux`` names are reserved), no leading dot, n
 # measured 580 B/px at 1920x1080, 500 B/px between 960x540 and 1920x1080).
 PROCESS_BASE_BYTES = 400 * 2**20
 BYTES_PER_FILM_PIXEL = 512
+# A JIT variant (LLVM, CUDA) adds its wavefront's state: ~450 bytes a lane (path), at most
+# metricscenes.lightgroups.MAX_WAVEFRONT_LANES lanes at once (measured with llvm_ad_spectral:
+# quick's 18.7 M-lane plate peaked at 7.5 GB, metric-300 in bands of 2**24 lanes at 7.9 GiB).
+# ``auto`` may resolve to one, so it is counted too.
+BYTES_PER_WAVEFRONT_LANE = 450
 MEMORY_LIMIT_ENV = "METRICSCENES_MAX_MEMORY_GIB"
 
 # Numbers: ints must be ints (not bools, floats or strings), floats may be ints but not
@@ -293,8 +298,16 @@ class Manifest(_Strict):
         return max(w * h, inset)
 
     def memory_estimate_bytes(self) -> int:
-        """Upper estimate of one render process's peak memory (see PROCESS_BASE_BYTES)."""
-        return PROCESS_BASE_BYTES + BYTES_PER_FILM_PIXEL * self.largest_film_px()
+        """Upper estimate of one render process's peak memory (see PROCESS_BASE_BYTES), with
+        the wavefront of a JIT variant (or of ``auto``) traced in bands of at most
+        ``MAX_WAVEFRONT_LANES`` lanes (see BYTES_PER_WAVEFRONT_LANE)."""
+        from metricscenes.lightgroups import MAX_WAVEFRONT_LANES
+
+        films = PROCESS_BASE_BYTES + BYTES_PER_FILM_PIXEL * self.largest_film_px()
+        if self.render.variant == "scalar_spectral":
+            return films
+        spp = max(self.render.plate_spp, self.render.inset_spp)
+        return films + BYTES_PER_WAVEFRONT_LANE * min(self.largest_film_px() * spp, MAX_WAVEFRONT_LANES)
 
 
 def memory_limit_bytes() -> tuple[int, str]:

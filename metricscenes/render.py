@@ -3,10 +3,12 @@
 Uses a ``specfilm`` with one 10 nm box band per ISET wavelength, so each channel is
 the band-averaged radiance in the emitters' units, a ``box`` reconstruction filter
 (bit-identical results whatever the thread count) and a ``stratified`` sampler (less
-per-band noise). On CPU the ``scalar_spectral`` variant is as fast as LLVM for this
-film and needs no libLLVM (see docs/performance.md); the LLVM variants crash with the
-system's libllvm15 and are only used when asked for explicitly. ``render.variant: auto``
-renders with ``cuda_ad_spectral`` where a CUDA device is usable (:func:`resolve_variant`).
+per-band noise). ``scalar_spectral`` needs no libLLVM; ``llvm_ad_spectral`` renders a unit's
+light groups in one pass (:mod:`metricscenes.lightgroups`), about twice as fast on 2 cores,
+but needs a libLLVM >= 17 (Debian's libllvm15 aborts the process), so it is probed in a
+child process first. ``render.variant: auto`` renders with ``cuda_ad_spectral`` where a
+CUDA device is usable, else with ``llvm_ad_spectral`` where it renders, else with
+``scalar_spectral`` (:func:`resolve_variant`; docs/performance.md).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM
 
 _active_variant: str | None = None
 CPU_VARIANT = "scalar_spectral"
+CPU_JIT_VARIANT = "llvm_ad_spectral"
 GPU_VARIANT = "cuda_ad_spectral"
 BLOCK_SIZE_PX = 32
 """The scalar renderer's image block, fixed (Mitsuba's default). Left unset, Mitsuba halves it
@@ -76,7 +79,8 @@ def is_jit_variant(variant: str) -> bool:
 def resolve_variant(setting: str) -> str:
     """The Mitsuba variant a ``render.variant`` setting means on this machine, checked
     (:class:`RenderError` if it cannot render here): ``auto`` is ``cuda_ad_spectral`` where a
-    CUDA device renders 2x2 pixels, else ``scalar_spectral``; any other setting is itself."""
+    CUDA device renders 2x2 pixels, else ``llvm_ad_spectral`` where a libLLVM renders them,
+    else ``scalar_spectral``; any other setting is itself."""
     from metricscenes.manifest import AUTO_VARIANT
 
     if setting != AUTO_VARIANT:
@@ -88,7 +92,11 @@ def resolve_variant(setting: str) -> str:
             return GPU_VARIANT
         except RenderError:
             pass  # a driver without a usable device (or a Mitsuba without CUDA variants)
-    return CPU_VARIANT
+    try:
+        check_variant(CPU_JIT_VARIANT)
+        return CPU_JIT_VARIANT
+    except RenderError:
+        return CPU_VARIANT  # no libLLVM, or one older than 17
 
 
 def _cuda_driver_present() -> bool:
