@@ -29,15 +29,9 @@ from dataclasses import replace
 import numpy as np
 
 from metricscenes.geometry import CAMERA_HEIGHT_M
+from metricscenes.manifest import MAX_WAVEFRONT_LANES
 from metricscenes.render import ILLUMINANCE_METER_SPP, RenderError, is_jit_variant, load_scene, with_illuminance_patch
 from metricscenes.spectral import WAVELENGTHS_NM
-
-# The most paths traced in one wavefront. Its state costs about 450 bytes a lane on the LLVM
-# backend (quick's 960 x 540 x 36 spp plate, 18.7 M lanes, peaked at 7.5 GB), so a metric-300
-# plate (1920 x 1080 x 36: 75 M lanes) traced whole would need about 30 GB. A larger window is
-# traced in bands of whole rows. Fixed, not taken from the machine's memory: the bands' seeds
-# are part of what is rendered, so every machine renders the same bytes.
-MAX_WAVEFRONT_LANES = 2**24
 
 
 def _mis_weight(pdf_a, pdf_b):

@@ -42,11 +42,15 @@ illuminance sweep's ``<base>@<level>lux`` names are reserved), no leading dot, n
 # measured 580 B/px at 1920x1080, 500 B/px between 960x540 and 1920x1080).
 PROCESS_BASE_BYTES = 400 * 2**20
 BYTES_PER_FILM_PIXEL = 512
-# A JIT variant (LLVM, CUDA) adds its wavefront's state: ~450 bytes a lane (path), at most
-# metricscenes.lightgroups.MAX_WAVEFRONT_LANES lanes at once (measured with llvm_ad_spectral:
-# quick's 18.7 M-lane plate peaked at 7.5 GB, metric-300 in bands of 2**24 lanes at 7.9 GiB).
-# ``auto`` may resolve to one, so it is counted too.
+# A JIT variant (LLVM, CUDA) adds its wavefront's state: ~450 bytes a lane (path; measured with
+# llvm_ad_spectral: quick's 18.7 M-lane plate peaked at 7.5 GB), so a metric-300 plate (1920 x
+# 1080 x 36: 75 M lanes) traced whole would need about 30 GB. metricscenes.lightgroups traces a
+# larger window in bands of whole rows of at most MAX_WAVEFRONT_LANES lanes (metric-300 peaked
+# at 7.9 GiB). Fixed, not taken from the machine's memory: the bands' seeds are part of what is
+# rendered, so every machine renders the same bytes. ``auto`` may resolve to a JIT variant, so
+# it is counted too.
 BYTES_PER_WAVEFRONT_LANE = 450
+MAX_WAVEFRONT_LANES = 2**24
 MEMORY_LIMIT_ENV = "METRICSCENES_MAX_MEMORY_GIB"
 
 # Numbers: ints must be ints (not bools, floats or strings), floats may be ints but not
@@ -301,8 +305,6 @@ class Manifest(_Strict):
         """Upper estimate of one render process's peak memory (see PROCESS_BASE_BYTES), with
         the wavefront of a JIT variant (or of ``auto``) traced in bands of at most
         ``MAX_WAVEFRONT_LANES`` lanes (see BYTES_PER_WAVEFRONT_LANE)."""
-        from metricscenes.lightgroups import MAX_WAVEFRONT_LANES
-
         films = PROCESS_BASE_BYTES + BYTES_PER_FILM_PIXEL * self.largest_film_px()
         if self.render.variant == "scalar_spectral":
             return films
