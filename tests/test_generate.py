@@ -67,15 +67,22 @@ def test_same_seed_same_bytes_other_seed_different(smoke_collection, smoke_manif
     assert not other_hashes & set(_resolved(smoke_collection)["arrays"].values())
 
 
-def test_killed_run_resumes_bit_identical_with_more_workers(smoke_collection, smoke_manifest, tmp_path):
+@pytest.mark.parametrize("fraction", [0.3, 0.7])
+def test_killed_run_resumes_bit_identical_with_more_workers(smoke_collection, smoke_manifest, tmp_path, fraction):
+    """Interrupted after about 30 % and 70 % of its units, resumed with two workers: the
+    same arrays and ground truth as the uninterrupted collection."""
     out = tmp_path / "resumed"
+    stopped_at = []
 
-    def stop_after_three(done, total, key):
-        if done >= 3 and key is not None:
+    def stop_part_way(done, total, key):
+        if key is not None and done >= max(1, round(fraction * total)):
+            stopped_at.append((done, total))
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        generate(smoke_manifest, out, progress=stop_after_three)
+        generate(smoke_manifest, out, progress=stop_part_way)
+    done, total = stopped_at[0]
+    assert 0 < done < total and abs(done / total - fraction) <= 1 / total
     assert not (out / "manifest.resolved.yaml").exists()
     with pytest.raises(CollectionError, match="missing"):
         Collection.open(out)
