@@ -15,7 +15,9 @@ record (bad JSON, a missing column, a field of the wrong type):
 
 Units, everywhere: AP and AP50 are unitless (COCO AP of the car, 0 to 1; NaN at a distance
 whose images hold no car); distances and OD50 are in metres (``_m``); exposures and timings
-in seconds (``_s``); MTF50 in cycles per mm on the sensor. OD50 may be **censored**: where AP
+in seconds (``_s``); MTF50 in cycles per mm on the sensor (``_cy_per_mm``) and, beside it,
+in cycles per mrad in object space (``_cy_per_mrad``: × focal length / 1000, what compares
+cameras whose focal lengths differ). OD50 may be **censored**: where AP
 does not cross 0.5 inside the measured distances the number is an extrapolation (or +inf),
 and what is reported is a bound, "> 200 m" or "< 25 m" (:mod:`benchmark.scoring.od50`,
 docs/detection.md). The records keep the number; :meth:`RunResults.od50_censoring`,
@@ -88,6 +90,11 @@ class CameraRecord(Record):
     f_number: float | None = None
     width_px: int | None = None
     height_px: int | None = None
+    focal_length_mm: float | None = None  # absent in results written before angular MTF50 was recorded
+    fov_deg: list[float] | None = None  # (horizontal, vertical) field of view
+    mtf50_cy_per_mm: float | None = None  # benchmark.measure.mtf.camera_mtf50: measured, else analytic
+    mtf50_cy_per_mrad: float | None = None  # the same in object space: × focal length / 1000
+    mtf50_source: str | None = None  # measured | analytic | published_group | none
     spec_sha256: str | None = None  # CameraSpec.sha256(): part of the sweep's cache key
     spec: dict[str, Any] | None = None  # CameraSpec.model_dump(mode="json"), kept as read (camera_from_dump checks it)
 
@@ -157,6 +164,9 @@ class RunResults(Record):
     subset: Subset | None = None
     exposure_short_s: dict[str, float] | None = None  # hdr only: the short frames per scene id
     captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
+    composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before session 12
+    condition_weights: dict[str, dict] | None = None  # a targeted condition: per scene, target and weights (metricscenes.targets)
+    numerics: dict | None = None  # versions, ISA class and kernels that decided the bytes (metricscenes.numeric_pins)
 
     def ap_curve(self) -> tuple[list[float], list[float]]:
         """(distances in m, AP) of ``per_distance``: the points OD50 is read from."""
@@ -254,6 +264,8 @@ class SweepRow(Record):
     ap: JsonFloat
     ap50: JsonFloat
     n_images: int
+    focal_length_mm: float | None = None  # absent in sweeps written before angular MTF50 was recorded
+    mtf50_cy_per_mrad: JsonFloat | None = None  # MTF50 in object space: mtf50_cy_per_mm × focal_length_mm / 1000
 
 
 class Od50Row(Record):
@@ -272,6 +284,8 @@ class Od50Row(Record):
     n_resamples: int
     n_environments: int
     n_infinite: int
+    focal_length_mm: float | None = None  # as SweepRow's
+    mtf50_cy_per_mrad: JsonFloat | None = None
     censored: Censored | None = None  # absent in sweeps written before censoring was recorded
 
 

@@ -16,8 +16,7 @@ import os
 import time
 
 from metricscenes import scene as scene_mod
-from metricscenes.generate import inset_window
-from metricscenes.groundtruth import car_box_tan
+from metricscenes.generate import scene_inset_window
 from metricscenes.manifest import load_manifest
 from metricscenes.plan import plan_collection
 from metricscenes.render import Film, render_radiance, use_variant
@@ -46,7 +45,7 @@ def main() -> None:
     for s in scenes:
         pose = scene_mod.car_pose(env, s.distance_m)
         with_car = parts.merged(scene_mod.car_parts(env, pose))
-        k, cx, cy, cw, ch = inset_window(car_box_tan(scene_mod.car_vertices(env, pose)), m)
+        k, cx, cy, cw, ch = scene_inset_window(m, env, scene_mod.car_vertices(env, pose))
         biggest_k = max(biggest_k, k)
         inset_s += timed(with_car, Film(ref_w * k, ref_h * k, cx, cy, cw, ch), m.render.inset_spp)
         inset_px += cw * ch

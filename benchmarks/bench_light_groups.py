@@ -20,8 +20,7 @@ import os
 import time
 
 from metricscenes import scene as scene_mod
-from metricscenes.generate import inset_window
-from metricscenes.groundtruth import car_box_tan
+from metricscenes.generate import scene_inset_window
 from metricscenes.lightgroups import passes, render_pass
 from metricscenes.manifest import load_manifest
 from metricscenes.plan import plan_collection
@@ -42,7 +41,7 @@ def main() -> None:
     def inset(distance: float):
         """The scene parts with the car at ``distance`` and its inset's film."""
         pose = scene_mod.car_pose(env, distance)
-        k, cx, cy, cw, ch = inset_window(car_box_tan(scene_mod.car_vertices(env, pose)), m)
+        k, cx, cy, cw, ch = scene_inset_window(m, env, scene_mod.car_vertices(env, pose))
         return (scene_mod.environment_parts(env).merged(scene_mod.car_parts(env, pose)),
                 Film(grid.width_px * k, grid.height_px * k, cx, cy, cw, ch, field=grid.field))
 

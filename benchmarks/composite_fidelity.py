@@ -23,6 +23,26 @@ for luminance Y (what a camera integrates: far less noisy than one 10 nm band). 
 unbiased if bias(C - A) is as small as bias(B - A) and MAD(C - A) / MAD(B - A) is ≈ 1 where C has
 the same noise as A (plate sampling) and ≈ 0.71 where C is much less noisy (the inset,
 area-averaged from k² finer pixels: sqrt(σ_A²) / sqrt(2 σ_A²)).
+
+    PYTHONPATH=. python benchmarks/composite_fidelity.py --seam [--collection DIR]
+        [--manifest manifests/quick.yaml] [--distances 100 200] [--cameras cam12 8mm]
+
+``--seam`` measures instead whether the inset's window shows in a camera's image (no full
+renders: it needs only the collection, ``--collection`` or the restricted one rendered as
+above). Each scene is captured noise-free (sensor noise off, D65 white balance: what is left
+is the composite and the render's own noise) by each camera, with the inset composited both
+ways (``Collection.radiance(..., inset_resolution=...)``): ``window`` (the inset's own
+resolution over its whole window, the composite before) and ``car`` (its own resolution on
+the car only), and the car-less plate alone at the same exposure. The CIELAB difference
+ΔE*ab per pixel between the two images (sRGB as the detector sees it) is zero outside the
+window; away from the car it is what the window shows: reported in bands of
+``SEAM_BAND_PX`` pixels along each edge of the window inside the frame, just inward of its
+feather ramp (mean, and the worst row or column along an edge: where the horizon crosses),
+over the whole window (mean, 99th percentile) and outside it; and the detail ratio in the
+window, mean |∇L*| of the composite over the plate's (1: as sharp as the plate around it).
+``8mm`` is cam12's sensor behind an 8 mm lens with 2.1 µm pixels
+(1920 × 1080, 28.3° × 16.1°: 0.26 mrad a pixel, finer than cam12's 0.32), a narrower camera
+than the paper's; any registry name or YAML path works.
 """
 
 from __future__ import annotations
@@ -34,15 +54,17 @@ from pathlib import Path
 import numpy as np
 
 from metricscenes import scene as scene_mod
-from metricscenes.generate import generate, inset_window
+from metricscenes.generate import generate, scene_inset_window
 from metricscenes.geometry import REFERENCE_EXTENT
-from metricscenes.groundtruth import car_box_tan
 from metricscenes.manifest import load_manifest, parse_manifest
 from metricscenes.photometry import radiance_to_xyz
 from metricscenes.plan import plan_collection
 from metricscenes.radiance import _overlap_matrix
 from metricscenes.render import Film, render_radiance, use_variant
 from metricscenes.store import Collection
+
+SEAM_BAND_PX = 3  # band width, camera pixels
+SEAM_GAP_PX = 1  # pixels left out inward of the feather ramp's end
 
 REPO = Path(__file__).resolve().parents[1]
 SEEDS = (0x5EED_A, 0x5EED_B)  # full renders A and B; the collection uses the manifest's seeds
@@ -119,14 +141,136 @@ def measure(manifest, collection: Collection, scene_plan, condition: str) -> lis
         rows.append({"grid": f"reference {ref_w}x{ref_h}", "region": region, **region_stats(comp, a, b, mask)})
     # 2. inset window at the inset's sampling
     pose = scene_mod.car_pose(scene_plan.environment, scene_plan.distance_m)
-    box = car_box_tan(scene_mod.car_vertices(scene_plan.environment, pose))
-    k, cx, cy, cw, ch = inset_window(box, manifest)
+    k, cx, cy, cw, ch = scene_inset_window(manifest, scene_plan.environment,
+                                           scene_mod.car_vertices(scene_plan.environment, pose))
     film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch)
     a, b = (render_whole(manifest, scene_plan, film, inset_spp, s, weights) for s in SEEDS)
     inset = spectral.layers[1].radiance
     rows.append({"grid": f"inset {cw}x{ch} (k={k})", "region": "window",
                  **region_stats(inset, a, b, np.ones(inset.shape[:2], dtype=bool))})
     return rows
+
+
+def seam_camera(name: str):
+    """A camera by registry name or YAML path; ``8mm``: cam12's sensor behind an 8 mm lens with
+    2.1 µm pixels, 1920 × 1080 (a narrower camera, finer in angle than cam12)."""
+    import yaml
+
+    from benchmark.camera import load_camera
+    from benchmark.camera.registry import DATA_DIR, camera_from_dict
+
+    if name != "8mm":
+        return load_camera(name)
+    data = yaml.safe_load((DATA_DIR / "cam12.yaml").read_text())
+    data.update(name="cam12-8mm-2.1um", label="cam12's sensor, 2.1 um pixel, 8 mm lens at f/1.9",
+                mtf50_group_cy_per_mm=None)
+    data["optics"]["focal_length_mm"] = 8.0
+    data["sensor"].update(pixel_um=2.1, active_width_mm=4.032, active_height_mm=2.268)
+    return camera_from_dict(data, source="8mm")
+
+
+def srgb8_to_lab(rgb8: np.ndarray) -> np.ndarray:
+    """CIELAB (D65 white) of 8-bit sRGB (IEC 61966-2-1), float64 (..., 3)."""
+    c = rgb8.astype(np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    m = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]])
+    xyz = lin @ m.T / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > (6 / 29) ** 3, np.cbrt(xyz), xyz / (3 * (6 / 29) ** 2) + 4 / 29)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], axis=-1)
+
+
+def seam_check(collection: Collection, scene_id: str, condition: str, camera, inset_resolution: str) -> dict:
+    """The seam figures of one scene in one camera's noise-free image: the per-pixel ΔE*ab
+    between the composite's image and the car-less plate's (same exposure and white balance),
+    which is zero outside the window, in bands along the window's edges just inward of its
+    feather ramp (mean, and the worst line along an edge), and over the whole window's
+    background (pixels farther from the car than :func:`metricscenes.radiance.car_sharpness`
+    keeps sharp: mean and 99th percentile); and the detail ratio there, mean |∇L*| of the
+    composite over the plate's (1: as sharp as the plate)."""
+    from benchmark.camera.exposure import with_exposure
+    from benchmark.camera.pipeline import sensor_extent, simulate
+    from benchmark.camera.spec import ExposureSpec
+    from metricscenes.radiance import SpectralScene, car_sharpness
+
+    if camera.optics.distortion is not None:
+        raise SystemExit(f"{camera.name}: the seam check maps the window without lens distortion; "
+                         "choose another camera")
+    # One white balance for both images (grey world would follow the car's few pixels).
+    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
+    camera = camera.model_copy(update={"isp": isp})
+    scene = collection.radiance(scene_id, condition, inset_resolution=inset_resolution)
+    plate, inset = scene.layers[0], scene.layers[1]
+    composite = simulate(scene, camera, seed=0, noise=False)
+    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
+    alone = simulate(SpectralScene(layers=(plate,)), fixed, seed=0, noise=False)
+    lab_c, lab_p = srgb8_to_lab(composite.rgb8), srgb8_to_lab(alone.rgb8)
+    de = np.linalg.norm(lab_c - lab_p, axis=-1)
+    # The window on the camera's grid, and its background: wholly inside, away from the car.
+    rows, cols = de.shape
+    e = sensor_extent(camera, scene.extent)
+    i = inset.extent
+    ox = _overlap_matrix(i.x0, i.x1, inset.radiance.shape[1], e.x0, e.x1, cols)
+    oy = _overlap_matrix(i.y0, i.y1, inset.radiance.shape[0], e.y0, e.y1, rows)
+    mask, _ = collection.mask(scene_id)
+    near_car = car_sharpness(mask, i, plate.pixel_tan).astype(np.float64)
+    near_car = oy @ (ox @ near_car.T).T
+    inside = np.outer(np.asarray(oy.sum(axis=1)).ravel(), np.asarray(ox.sum(axis=1)).ravel()) > 1 - 1e-6
+    background = inside & (near_car == 0)
+    sx, sy = cols / e.width, rows / e.height
+    x0, x1 = (i.x0 - e.x0) * sx, (i.x1 - e.x0) * sx
+    y0, y1 = (i.y0 - e.y0) * sy, (i.y1 - e.y0) * sy
+    rx, ry = inset.feather * (x1 - x0), inset.feather * (y1 - y0)
+    c0, c1 = int(np.ceil(x0 + rx)) + SEAM_GAP_PX, int(np.floor(x1 - rx)) - SEAM_GAP_PX
+    r0, r1 = int(np.ceil(y0 + ry)) + SEAM_GAP_PX, int(np.floor(y1 - ry)) - SEAM_GAP_PX
+    n = SEAM_BAND_PX
+    bands = []  # (ΔE, background) over a band, lines along the edge first
+    if x0 > 0:
+        bands.append((de[r0:r1, c0:c0 + n], background[r0:r1, c0:c0 + n]))
+    if x1 < cols:
+        bands.append((de[r0:r1, c1 - n:c1], background[r0:r1, c1 - n:c1]))
+    if y0 > 0:
+        bands.append((de[r0:r0 + n, c0:c1].T, background[r0:r0 + n, c0:c1].T))
+    if y1 < rows:
+        bands.append((de[r1 - n:r1, c0:c1].T, background[r1 - n:r1, c0:c1].T))
+    if not background.any():  # the window is all within the car's few plate pixels (e.g. smoke's far cars)
+        raise SystemExit(f"{scene_id}: no pixel of the window lies away from the car on {camera.name}'s grid")
+    border = np.concatenate([d[b] for d, b in bands] + [np.zeros(0)])
+    lines = [float(d[k][b[k]].mean()) for d, b in bands for k in range(d.shape[0]) if b[k].any()] or [np.nan]
+    grad = [np.abs(np.diff(lab[..., 0], axis=a)) for lab in (lab_c, lab_p) for a in (0, 1)]
+
+    def detail(along_rows: np.ndarray, along_cols: np.ndarray) -> float:
+        return float(along_rows[background[1:] & background[:-1]].mean()
+                     + along_cols[background[:, 1:] & background[:, :-1]].mean())
+
+    return {"border_px": int(border.size), "border_de": float(border.mean()) if border.size else np.nan,
+            "border_de_max_line": max(lines), "window_px": int(background.sum()),
+            "window_de": float(de[background].mean()), "window_de_p99": float(np.percentile(de[background], 99)),
+            "outside_de": float(de[~inside].mean()),
+            "detail_ratio": detail(grad[0], grad[1]) / detail(grad[2], grad[3])}
+
+
+def seam_main(args, collection: Collection) -> None:
+    scenes = [s.scene_id for s in collection.scenes()
+              if s.environment_id == args.environment and any(abs(s.distance_m - d) < 1e-6 for d in args.distances)]
+    if not scenes:
+        raise SystemExit(f"error: no scene of environment {args.environment} at {args.distances} m "
+                         f"in {collection.root}")
+    print(f"condition {args.condition}; noise-free captures (D65 white balance); ΔE*ab per pixel of the composite's "
+          f"image against the car-less plate's (same exposure), away from the car: in {SEAM_BAND_PX}-px bands along "
+          f"the window's edges inward of its ramp (mean; worst line), over the window (mean; 99th pct), outside it; "
+          f"detail: mean |grad L*| in the window, composite / plate")
+    header = (f"{'camera':<18}{'scene':<14}{'inset':<8}{'border':>8}{'worst line':>11}{'window':>8}{'p99':>7}"
+              f"{'outside':>8}{'detail':>8}")
+    print(header)
+    print("-" * len(header))
+    for name in args.cameras:
+        camera = seam_camera(name)
+        for scene_id in scenes:
+            for mode in ("window", "car"):
+                r = seam_check(collection, scene_id, args.condition, camera, mode)
+                print(f"{camera.name:<18}{scene_id:<14}{mode:<8}{r['border_de']:>8.2f}{r['border_de_max_line']:>11.1f}"
+                      f"{r['window_de']:>8.2f}{r['window_de_p99']:>7.1f}{r['outside_de']:>8.2f}"
+                      f"{r['detail_ratio']:>8.2f}")
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -137,12 +281,22 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--condition", default="day")
     p.add_argument("--work", type=Path, default=Path("/tmp/composite-fidelity"))
     p.add_argument("--threads", type=int, default=None)
+    p.add_argument("--seam", action="store_true", help="measure the window's seam in camera images instead")
+    p.add_argument("--collection", type=Path, default=None,
+                   help="with --seam: an existing collection (e.g. collections/quick) instead of rendering one")
+    p.add_argument("--cameras", nargs="+", default=["cam12", "8mm"], help="with --seam (8mm: see the docstring)")
     args = p.parse_args(argv)
+    if args.seam and args.collection is not None:
+        seam_main(args, Collection.open(args.collection))
+        return
     manifest = restricted_manifest(args.manifest, args.environment, args.distances, args.condition)
     out = args.work / manifest.sha256()[:12]
     started = time.perf_counter()
     generate(manifest, out, threads=args.threads)  # resumes: a rerun only re-measures
     print(f"collection {out} ready in {time.perf_counter() - started:.1f} s")
+    if args.seam:
+        seam_main(args, Collection.open(out))
+        return
     use_variant(manifest.render.variant, args.threads)
     collection = Collection.open(out)
     plans = [s for s in plan_collection(manifest) if s.environment.environment_id == args.environment]

@@ -390,8 +390,7 @@ def metric300_pixels(manifest_path: Path) -> dict[str, float]:
     (``render.frame_divisor``), insets sized by
     its plan (``inset_window``, mean over its environments); and its number of environments."""
     from metricscenes import scene as scene_mod
-    from metricscenes.generate import inset_window
-    from metricscenes.groundtruth import car_box_tan
+    from metricscenes.generate import scene_inset_window
     from metricscenes.manifest import load_manifest
     from metricscenes.plan import plan_collection
 
@@ -400,7 +399,7 @@ def metric300_pixels(manifest_path: Path) -> dict[str, float]:
     inset_px = 0
     for s in scenes:
         pose = scene_mod.car_pose(s.environment, s.distance_m)
-        _, _, _, w, h = inset_window(car_box_tan(scene_mod.car_vertices(s.environment, pose)), m)
+        _, _, _, w, h = scene_inset_window(m, s.environment, scene_mod.car_vertices(s.environment, pose))
         inset_px += w * h
     grid = m.reference_grid.width_px * m.reference_grid.height_px
     frame_w, frame_h = m.frame_grid_px()

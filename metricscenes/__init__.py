@@ -4,6 +4,11 @@ Stages (each its own module, data flows one way):
 manifest -> plan -> scene (Mitsuba) -> render -> store (zarr) -> SpectralScene.
 """
 
+# Before anything imports numpy: the same numeric kernels on every x86-64 machine.
+from metricscenes.numeric_pins import pin_numeric_libraries
+
+pin_numeric_libraries()
+
 from importlib.metadata import PackageNotFoundError, version
 
 try:

@@ -24,10 +24,11 @@ err = Console(stderr=True)
 def _user_errors():
     from metricscenes.backends import BackendError
     from metricscenes.manifest import ManifestError
+    from metricscenes.outputs import OutputError
     from metricscenes.render import RenderError
     from metricscenes.store import CollectionError
 
-    return (ManifestError, CollectionError, RenderError, BackendError)
+    return (ManifestError, CollectionError, RenderError, BackendError, OutputError)
 
 
 @app.command()
@@ -57,6 +58,9 @@ def generate(
             fail("--out is required unless --dry-run")
         from metricscenes.generate import check_before_writing
         from metricscenes.generate import generate as run_generate
+        from metricscenes.outputs import COLLECTION, check_output
+
+        check_output(out, "--out", own=COLLECTION)  # not inside a run, sweep or leaderboard folder
 
         # Before any output: --out, --scheduler, the memory estimate, the variant (LLVM can abort
         # the process, CUDA needs a GPU). generate() checks them again (cheaply), then locks --out.
@@ -118,8 +122,11 @@ def info(
         "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved.arrays),
         "radiance_units": "W sr-1 m-2 nm-1", "wavelengths_nm": [400, 700, 10], "store_bytes": size,
     }
-    if photometry:
-        summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.condition_names]
+    if photometry:  # reads every scene's radiance: damage found on the way is one line
+        try:
+            summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.condition_names]
+        except _user_errors() as exc:
+            fail(str(exc))
     if as_json:
         print(json.dumps(summary, indent=1))
         return
@@ -134,22 +141,25 @@ def info(
 
 def _photometry_table(rows: list[dict]) -> None:
     """Mean over scenes, per condition."""
-    table = Table(title="photometry (mean over scenes)")
-    for col in ("condition", "lux at camera", "luminance cd/m²", "image-plane lux f/2.4"):
+    table = Table(title="photometry (mean over scenes; --json: each scene, and a targeted condition's weights)")
+    for col in ("condition", "lux at camera", "luminance cd/m²", "image-plane lux f/2.4", "min-max", "over target"):
         table.add_column(col, justify="right")
     for cond in dict.fromkeys(r["condition"] for r in rows):
         sel = [r for r in rows if r["condition"] == cond]
         mean = {k: sum(r[k] for r in sel) / len(sel)
                 for k in ("illuminance_at_camera_lux", "mean_luminance_cd_m2", "image_plane_illuminance_lux")}
+        plane = [r["image_plane_illuminance_lux"] for r in sel]
+        over = (f"{sum(r['targeted']['over_target'] for r in sel)} of {len(sel)}" if "targeted" in sel[0] else "")
         table.add_row(cond, f"{mean['illuminance_at_camera_lux']:.4g}", f"{mean['mean_luminance_cd_m2']:.4g}",
-                      f"{mean['image_plane_illuminance_lux']:.4g}")
+                      f"{mean['image_plane_illuminance_lux']:.4g}", f"{min(plane):.3g}-{max(plane):.3g}", over)
     console.print(table)
 
 
 @app.command()
 def verify(collection: Annotated[Path, typer.Argument(help="collection folder")]) -> None:
-    """Check the whole collection: resolved manifest, every array's sha256 (masks too), ground truth."""
-    from metricscenes.store import verify_collection
+    """Check the whole collection: resolved manifest, every array's sha256 (masks too) and its
+    attributes', ground truth."""
+    from metricscenes.store import upgrade_notes, verify_collection
 
     problems = verify_collection(collection)
     for line in problems:
@@ -157,14 +167,17 @@ def verify(collection: Annotated[Path, typer.Argument(help="collection folder")]
     if problems:
         fail(f"{collection}: {len(problems)} problem(s); rerun `metricscenes generate` with its manifest to repair it",
              code=1)
-    console.print("manifest, arrays and ground truth match their records")
+    for line in upgrade_notes(collection):
+        console.print(f"note: {collection}: {line}", highlight=False, soft_wrap=True)
+    console.print("manifest, arrays, their attributes and ground truth match their records")
 
 
 @app.command()
 def preview(
     collection: Annotated[Path, typer.Argument(help="collection folder")],
     condition: Annotated[str, typer.Option(help="condition to show")] = "day",
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="PNG to write")] = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="PNG to write (default: preview-<collection>-<condition>.png here)")] = None,
     columns: Annotated[int, typer.Option(min=1)] = 6,
     white: Annotated[Optional[float], typer.Option(
         min=1e-12, help="luminance (cd/m²) drawn at 80 % of full scale, the same for every tile "
@@ -173,6 +186,7 @@ def preview(
 ) -> None:
     """Write an sRGB contact sheet of every scene (display rendering, not a camera): one
     exposure for the whole sheet, so night looks like night."""
+    from metricscenes.outputs import check_file_output
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.preview import contact_sheet, white_luminance, xyz_to_srgb8
     from metricscenes.store import Collection
@@ -182,6 +196,8 @@ def preview(
 
     try:
         c = Collection.open(collection)
+        # Never into the collection (read-only): here by default; a PNG, checked before any work.
+        out = check_file_output(out or Path(f"preview-{c.name}-{condition}.png"), "--out", (".png",))
         width, height = c.reference_grid
         scenes = c.scenes()
         sheet_white = white
@@ -203,7 +219,7 @@ def preview(
     except _user_errors() as exc:
         fail(str(exc))
     labels = [f"{s.scene_id} {condition}" for s in scenes]
-    path = contact_sheet(tiles, labels, columns, out or collection / f"preview-{condition}.png")
+    path = contact_sheet(tiles, labels, columns, out)
     exposure = "each tile exposed for itself" if per_tile else f"white = {sheet_white:.4g} cd/m² for every tile"
     console.print(f"wrote {path} ({exposure})")
 
@@ -221,8 +237,10 @@ def export_cmd(
 ) -> None:
     """Export one scene's composited radiance and photons (with wave, fov, distance, box) for ISETCam."""
     from metricscenes.export import ExportError, export_scene
+    from metricscenes.outputs import check_file_output
 
     try:
+        check_file_output(out, "OUT", (".h5", ".hdf5"))  # never into a collection, a run or a leaderboard
         path = export_scene(collection, scene, condition, fmt, out, width_px=width_px, gzip=gzip)
     except (*_user_errors(), ExportError) as exc:
         fail(str(exc))
@@ -240,9 +258,11 @@ def preview_assets_cmd(
     columns: Annotated[int, typer.Option(min=1)] = 10,
 ) -> None:
     """Render a labelled contact sheet of the 50 library cars or the 30 skies (docs/img/)."""
+    from metricscenes.outputs import check_file_output
     from metricscenes.preview_assets import AssetPreviewError, asset_contact_sheet
 
     try:
+        check_file_output(out, "--out", (".png",))  # before rendering anything
         chosen = None
         if ids is not None:
             try:

@@ -6,6 +6,7 @@ the other way round).
 
 from __future__ import annotations
 
+import time
 from contextlib import contextmanager
 from typing import NoReturn
 
@@ -28,9 +29,58 @@ def fail(message: str, code: int = 2) -> NoReturn:
     raise typer.Exit(code)
 
 
+class LogProgress:
+    """Progress for a log file: a plain line every ``step`` of the units or every ``every_s``
+    seconds, whichever comes first (units done, elapsed, estimated remaining). What
+    :func:`progress_bar` gives where its console is not a terminal (``rich`` would print
+    nothing until the end)."""
+
+    def __init__(self, console: Console, step: float = 0.05, every_s: float = 30.0, clock=time.monotonic):
+        self.console, self.step, self.every_s, self.clock = console, step, every_s, clock
+        self.tasks: dict[int, dict] = {}
+
+    def add_task(self, description: str, total: float | None = None, **_) -> int:
+        now = self.clock()
+        self.tasks[len(self.tasks)] = {"description": description, "total": total, "completed": 0,
+                                       "started": now, "printed_at": now, "printed_fraction": 0.0}
+        return len(self.tasks) - 1
+
+    def update(self, task: int, completed: float | None = None, total: float | None = None,
+               description: str | None = None, **_) -> None:
+        t = self.tasks[task]
+        for key, value in (("completed", completed), ("total", total), ("description", description)):
+            if value is not None:
+                t[key] = value
+        now = self.clock()
+        fraction = t["completed"] / t["total"] if t["total"] else 0.0
+        done = bool(t["total"]) and t["completed"] >= t["total"]
+        if done or fraction >= t["printed_fraction"] + self.step or now - t["printed_at"] >= self.every_s:
+            t["printed_at"], t["printed_fraction"] = now, fraction
+            self.console.print(self.line(t, now), highlight=False, soft_wrap=True, markup=False)
+
+    @staticmethod
+    def line(t: dict, now: float) -> str:
+        elapsed = now - t["started"]
+        if not t["total"]:
+            return f"{t['description']}: {t['completed']:g} done, {_duration(elapsed)} elapsed"
+        fraction = t["completed"] / t["total"]
+        left = f", about {_duration(elapsed * (1 - fraction) / fraction)} left" if 0 < fraction < 1 else ""
+        return (f"{t['description']}: {t['completed']:g}/{t['total']:g} ({100 * fraction:.0f} %), "
+                f"{_duration(elapsed)} elapsed{left}")
+
+
+def _duration(seconds: float) -> str:
+    seconds = int(round(seconds))
+    return f"{seconds // 3600} h {seconds % 3600 // 60:02d} min" if seconds >= 3600 else f"{seconds // 60} min {seconds % 60:02d} s"
+
+
 @contextmanager
 def progress_bar(console: Console, disable: bool = False):
-    """A rich progress bar that vanishes if the block fails, so an error stays one line."""
+    """A rich progress bar that vanishes if the block fails, so an error stays one line;
+    where ``console`` is not a terminal (a log), plain lines instead (:class:`LogProgress`)."""
+    if not disable and not console.is_terminal:
+        yield LogProgress(console)
+        return
     bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TimeElapsedColumn(), TimeRemainingColumn(), console=console, transient=False, disable=disable)
     with bar:

@@ -18,7 +18,7 @@ import math
 import os
 import time
 from contextlib import closing
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -56,17 +56,74 @@ def plan_units(scenes: list[ScenePlan]) -> list[Unit]:
     return list(units.values())
 
 
-def inset_window(box_tan, manifest: Manifest) -> tuple[int, int, int, int, int]:
+# The road surface the car stands on (metricscenes.assets.roads: paved road at z = 0), onto
+# which render.inset_shadow projects the car along its sky's sun or moon.
+SHADOW_PLANE_Z_M = 0.0
+# A shadow point closer ahead than this is taken at this distance (projected far below the
+# field, so the window reaches the field's bottom edge, which clips it).
+_SHADOW_MIN_AHEAD_M = 1.0
+
+
+def shadow_light_directions(env: EnvironmentPlan, light_groups) -> list[tuple[float, float, float]]:
+    """Unit vectors (world frame) towards each directional light that casts the car's shadow
+    in the rendered sky groups of ``light_groups``: the day sky's sun, the dusk sky's sun only
+    if above the horizon (never in the library: its sunsky has no sun disk), the moonlit night
+    sky's moon (:mod:`metricscenes.assets.skies`). Lights at or below the horizon add none."""
+    from metricscenes.assets import skies
+
+    out = []
+    for group, attr in (("sky_day", "sky_day_id"), ("sky_dusk", "sky_dusk_id"), ("sky_night", "sky_night_id")):
+        if group not in light_groups:
+            continue
+        sky = skies.sky_spec(getattr(env, attr))
+        if sky.kind in ("day", "dusk") and sky.sun_elevation_deg > 0.0:
+            out.append(tuple(skies._direction(sky.sun_elevation_deg, sky.sun_azimuth_deg)))
+        if sky.kind == "night" and sky.moon_normal_illuminance_lux > 0.0 and sky.moon_elevation_deg > 0.0:
+            out.append(tuple(skies._direction(sky.moon_elevation_deg, sky.moon_azimuth_deg)))
+    return out
+
+
+def shadow_vertices(vertices_world_m: np.ndarray, towards_light, plane_z_m: float = SHADOW_PLANE_Z_M) -> np.ndarray:
+    """The car's vertices projected along the light (``towards_light``: a direction to the
+    source, above the horizon) onto the plane z = ``plane_z_m``: their shadow's points."""
+    v = np.asarray(vertices_world_m, dtype=np.float64)
+    d = np.asarray(towards_light, dtype=np.float64)
+    if d[2] <= 0.0:
+        raise ValueError(f"the light must be above the horizon, got direction {tuple(d)}")
+    height = np.maximum(v[:, 2] - plane_z_m, 0.0)  # (vertices under the plane stay where they are)
+    out = v - height[:, None] * (d / d[2])[None, :]
+    out[:, 2] = np.where(v[:, 2] > plane_z_m, plane_z_m, v[:, 2])
+    out[:, 0] = np.maximum(out[:, 0], _SHADOW_MIN_AHEAD_M)
+    return out
+
+
+def shadow_box_tan(manifest: Manifest, env: EnvironmentPlan, car_vertices_m: np.ndarray):
+    """The box (tangent coordinates) of the car's shadows on the road under every rendered
+    sky's sun or moon when ``render.inset_shadow`` is set, else None (also when no sky has one)."""
+    if not manifest.render.inset_shadow:
+        return None
+    lights = shadow_light_directions(env, manifest.light_groups)
+    boxes = [car_box_tan(shadow_vertices(car_vertices_m, d)) for d in lights]
+    if not boxes:
+        return None
+    return (min(b[0] for b in boxes), min(b[1] for b in boxes), max(b[2] for b in boxes), max(b[3] for b in boxes))
+
+
+def inset_window(box_tan, manifest: Manifest, cover_tan=None) -> tuple[int, int, int, int, int]:
     """Choose the inset film: scale ``k`` of the reference grid and the crop (x, y, w, h)
     in that film's pixels. ``k`` gives ``inset_pixel_mrad`` sampling unless the window
     would exceed ``inset_max_px`` (near cars, which are large in every camera anyway).
-    With ``render.inset_feather`` the window also holds the ramp over which the reader
-    blends it into the plate (:func:`metricscenes.radiance.feather_weights`)."""
+    ``cover_tan``, a box (tangent coordinates) the window must also hold before its margins
+    (the car's shadow: :func:`shadow_box_tan`), or None; the margins stay shares of the car's
+    box ``box_tan``. With ``render.inset_feather`` the window also holds the ramp over which
+    the reader blends it into the plate (:func:`metricscenes.radiance.feather_weights`)."""
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     e = manifest.reference_grid.field
     bw, bh = box_tan[2] - box_tan[0], box_tan[3] - box_tan[1]
-    x0, x1 = box_tan[0] - INSET_MARGIN["left"] * bw, box_tan[2] + INSET_MARGIN["right"] * bw
-    y0, y1 = box_tan[1] - INSET_MARGIN["top"] * bh, box_tan[3] + INSET_MARGIN["bottom"] * bh
+    held = box_tan if cover_tan is None else (min(box_tan[0], cover_tan[0]), min(box_tan[1], cover_tan[1]),
+                                              max(box_tan[2], cover_tan[2]), max(box_tan[3], cover_tan[3]))
+    x0, x1 = held[0] - INSET_MARGIN["left"] * bw, held[2] + INSET_MARGIN["right"] * bw
+    y0, y1 = held[1] - INSET_MARGIN["top"] * bh, held[3] + INSET_MARGIN["bottom"] * bh
     if manifest.render.inset_feather:
         # The blend ramp (a share f of the window at each side) lies outside the margins, so the
         # car and all it changes nearby keep the inset's full weight: W' (1 - 2 f) = W.
@@ -112,8 +169,9 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     else:
         env_parts = parts
         pose = scene_mod.car_pose(env, unit.distance_m)
-        parts = parts.merged(scene_mod.car_parts(env, pose))
-        film, extent, projected_box, k = _inset_film(manifest, scene_mod.car_vertices(env, pose))
+        parts = parts.merged(scene_mod.car_parts(env, pose, plate_lamp=bool(manifest.render.plate_lamp),
+                                                 rear_retroreflectors=bool(manifest.render.rear_retroreflectors)))
+        film, extent, projected_box, k = _inset_film(manifest, scene_mod.car_vertices(env, pose), env)
         mask, mask_box = _instance_mask(manifest, unit, env_parts, parts, film, extent)
         arrays.write_mask(mask, extent)
         grid = manifest.reference_grid
@@ -148,7 +206,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     return UnitRecord(unit=unit.key, kind=unit.kind, arrays=arrays.sha256,
                       seconds=round(time.perf_counter() - started, 3),
                       illuminance_lux=illuminance or None,  # (a plate no group lights records none)
-                      inset=inset)
+                      inset=inset, attributes=arrays.attributes_sha256)
 
 
 def _renders(lit_jobs: list, one_pass: bool) -> list:
@@ -167,14 +225,20 @@ def _renders(lit_jobs: list, one_pass: bool) -> list:
             for target, index in by_film.items() for groups in passes(list(index))]
 
 
-def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray):
+def scene_inset_window(manifest: Manifest, env: EnvironmentPlan, car_vertices_m: np.ndarray):
+    """:func:`inset_window` of a scene's car: its projected box, and its shadows' where the
+    manifest asks (``render.inset_shadow``)."""
+    return inset_window(car_box_tan(car_vertices_m), manifest, shadow_box_tan(manifest, env, car_vertices_m))
+
+
+def _inset_film(manifest: Manifest, car_vertices_m: np.ndarray, env: EnvironmentPlan):
     """The inset's film (a crop of a k-times finer reference film), its extent in tangent
     coordinates, the car's projected box (tangent coordinates) and k."""
     from metricscenes.render import Film
 
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     box = car_box_tan(car_vertices_m)
-    k, cx, cy, cw, ch = inset_window(box, manifest)
+    k, cx, cy, cw, ch = scene_inset_window(manifest, env, car_vertices_m)
     e = manifest.reference_grid.field
     film = Film(ref_w * k, ref_h * k, cx, cy, cw, ch, field=e)
     extent = TanExtent(e.x0 + cx / film.width * e.width, e.y0 + cy / film.height * e.height,
@@ -212,12 +276,15 @@ def _record_problem(root: Path, group, record: UnitRecord, manifest: Manifest) -
     the bytes its record names; a mask that does not give the recorded box), or None:
     the progress record is a claim, not proof."""
     key = record.unit
+    # (records written before attributes had a sha256 have none: _record_attributes checks them)
+    attributes = {} if record.attributes is None else record.attributes
+    fallback = None if record.attributes is None else ""
     try:
         for path, sha in sorted(record.arrays.items()):
-            read_checked(root, group, path, sha, key)
+            read_checked(root, group, path, sha, key, attributes.get(path, fallback))
         if record.inset is not None:  # the box goes into groundtruth.json: it must be the mask's
             path = f"masks/{key}"  # (records written before masks had a sha256 have none for it)
-            mask, attrs = read_checked(root, group, path, record.arrays.get(path), key)
+            mask, attrs = read_checked(root, group, path, record.arrays.get(path), key, attributes.get(path, fallback))
             box = mask_box_tan(mask.astype(bool), TanExtent(*attrs["extent_tan"]))
             grid = manifest.reference_grid
             xywh = None if box is None else tuple(box_tan_to_xywh(box, grid.width_px, grid.height_px, grid.field))
@@ -234,6 +301,66 @@ def _incomplete(key: str) -> str:
     return f"{key}: its progress record is incomplete"
 
 
+def _expected_attributes(manifest: Manifest, unit: Unit, path: str, stored: dict) -> dict:
+    """The attributes :func:`render_unit` writes on ``path``, one of ``unit``'s arrays (its
+    ``spectral_basis`` is taken as stored: it is under the array's sha256, which is of the
+    values decoded through it)."""
+    from metricscenes import scene as scene_mod
+    from metricscenes.writer import mask_attributes, radiance_attributes
+
+    kind = path.split("/")[0]
+    extent = manifest.reference_grid.field
+    if unit.kind != PLATE:
+        pose = scene_mod.car_pose(unit.environment, unit.distance_m)
+        extent = _inset_film(manifest, scene_mod.car_vertices(unit.environment, pose), unit.environment)[1]
+    if kind == "masks":
+        return mask_attributes(extent)
+    if kind == "frames":
+        extent = manifest.reference_grid.field
+    store = manifest.store
+    spp = manifest.render.inset_spp if kind == "insets" else manifest.render.plate_spp
+    basis = stored.get("spectral_basis") if store and store.spectral_basis else None
+    return radiance_attributes(path.split("/")[-1], extent, store.mantissa_bits if store else None, basis,
+                               {"spp": spp, "seed": unit.seed})
+
+
+def _attribute_difference(stored: dict, expected: dict) -> str | None:
+    """The first attribute in which ``stored`` differs from ``expected``, or None (extents
+    may differ by 1e-12, rounding of another machine)."""
+    for name in sorted(set(stored) | set(expected)):
+        a, b = stored.get(name), expected.get(name)
+        if name == "extent_tan" and isinstance(a, list) and len(a) == 4 and b is not None:
+            try:
+                if np.allclose(np.asarray(a, dtype=np.float64), b, rtol=0.0, atol=1e-12):
+                    continue
+            except (TypeError, ValueError):
+                pass
+            return name
+        if a != b:
+            return name
+    return None
+
+
+def _record_attributes(group, record: UnitRecord, manifest: Manifest, unit: Unit) -> tuple[str | None, UnitRecord]:
+    """A record written before attributes had a sha256, given them: each of its arrays'
+    attributes, checked against what :func:`render_unit` writes, and hashed (metadata only:
+    nothing is rendered). Returns (why the unit must be rendered again, the record as it
+    was) or (None, the record with its ``attributes``)."""
+    from metricscenes.store import attributes_sha256
+
+    hashes = {}
+    for path in sorted(record.arrays):
+        try:
+            stored = dict(group[path].attrs)
+        except Exception:
+            return f"{record.unit}: {path} is missing or unreadable", record
+        different = _attribute_difference(stored, _expected_attributes(manifest, unit, path, stored))
+        if different:
+            return f"{record.unit}: {path} attribute {different!r} is not the one written", record
+        hashes[path] = attributes_sha256(stored)
+    return None, replace(record, attributes=hashes)
+
+
 def _finished_units(writer: CollectionWriter, units: list[Unit], manifest: Manifest,
                     notice) -> dict[str, UnitRecord | None]:
     """The record of each unit, None for those to render (again): no record, or one whose
@@ -248,6 +375,10 @@ def _finished_units(writer: CollectionWriter, units: list[Unit], manifest: Manif
             problem = None if record is None else _record_problem(writer.root, group, record, manifest)
         except RecordError:
             record, problem = None, _incomplete(u.key)
+        if record is not None and not problem and record.attributes is None:  # written before they had a sha256
+            problem, record = _record_attributes(group, record, manifest, u)
+            if not problem:
+                writer.write_record(record)
         if problem:
             record = None
             if notice:

@@ -46,7 +46,12 @@ def _mis_weight(pdf_a, pdf_b):
 class _Groups:
     """The scene's emitters by group, in the forms the traced kernel reads: per group an
     ``EmitterPtr`` array to sample from, and lookups from an emitter pointer's registry
-    index to its group and to its selection probability within the group."""
+    index to its group and to its selection probability within the group.
+
+    As Mitsuba's own emitter sampling does, an emitter whose ``sampling_weight`` is 0 is
+    never chosen by next-event estimation (its selection probability is 0, so a path that
+    hits it counts it in full); the others of a group are chosen uniformly, so their
+    weights must be equal."""
 
     def __init__(self, emitter_groups: Mapping[object, int], n_groups: int):
         import drjit as dr
@@ -54,14 +59,21 @@ class _Groups:
 
         members: list[list] = [[] for _ in range(n_groups)]
         for emitter, group in emitter_groups.items():
-            members[group].append(emitter)
+            if emitter.sampling_weight() > 0:
+                members[group].append(emitter)
+        for group, emitters in enumerate(members):
+            if len({float(e.sampling_weight()) for e in emitters}) > 1:
+                raise RenderError(f"light group {group}: its emitters' sampling weights differ "
+                                  "(one-pass light groups sample a group's emitters uniformly)")
         index = {e: int(dr.reinterpret_array(mi.UInt32, mi.EmitterPtr(e))[0]) for e in emitter_groups}
         size = max(index.values(), default=0) + 1
         group_of = np.full(size, n_groups, dtype=np.uint32)  # n_groups: an emitter of no group
-        pmf = np.zeros(size, dtype=np.float32)
-        for group, emitters in enumerate(members):
+        pmf = np.zeros(size, dtype=np.float32)  # 0: an emitter next-event estimation never chooses
+        for emitter, group in emitter_groups.items():
+            group_of[index[emitter]] = group
+        for emitters in members:
             for e in emitters:
-                group_of[index[e]], pmf[index[e]] = group, 1.0 / len(emitters)
+                pmf[index[e]] = 1.0 / len(emitters)
         self.members = [mi.EmitterPtr(emitters) if emitters else None for emitters in members]
         self.counts = [len(emitters) for emitters in members]
         self.group_table, self.pmf_table = mi.UInt32(group_of), mi.Float(pmf)

@@ -1,7 +1,9 @@
-"""One writer per collection: ``<collection>/generate.lock``.
+"""One writer per collection: ``<collection>/generate.lock``; one per run or sweep folder:
+``<folder>/benchmark.lock`` (:func:`folder_lock`, taken by ``benchmark run`` and ``sweep``).
 
 ``metricscenes generate`` holds an exclusive ``flock`` on the lock file for as long as it
-writes, and the file says who holds it (PID, host, the process's start time, since when).
+writes, and the file says who holds it (PID, host, the process's start time, since when,
+the command).
 A second writer is refused with one line naming the holder. The kernel drops the
 ``flock`` when its holder dies, however it dies, so a lock file left by a killed run is
 stale and the next writer takes it over (with a notice); where ``flock`` is not shared
@@ -22,6 +24,7 @@ from pathlib import Path
 from metricscenes.store import CollectionError
 
 LOCK_FILE = "generate.lock"
+OUTPUT_LOCK_FILE = "benchmark.lock"  # a run or sweep folder's (benchmark writes no collection)
 
 
 class LockError(CollectionError):
@@ -54,6 +57,11 @@ def _alive(holder: dict) -> bool:
     return started is None or now is None or started == now
 
 
+def output_lock(root: str | Path, command: str, what: str, notice=None):
+    """:func:`folder_lock` on a run or sweep folder's ``benchmark.lock``."""
+    return folder_lock(root, command, what, notice=notice, lock_file=OUTPUT_LOCK_FILE)
+
+
 def describe(holder: dict | None) -> str:
     if not holder:
         return "a holder that wrote no details"
@@ -69,7 +77,13 @@ def _read(fd: int) -> dict | None:
     return data if isinstance(data, dict) else None
 
 
-def _acquire(path: Path, notice) -> int:
+def _refusal(path: Path, holder: dict | None, command: str, what: str) -> LockError:
+    holding = (holder or {}).get("command") or command
+    return LockError(f"{path.parent}: another `{holding}` is writing this {what} ({describe(holder)}; lock file "
+                     f"{path}); wait for it or stop it")
+
+
+def _acquire(path: Path, notice, command: str, what: str) -> int:
     import fcntl
 
     host = socket.gethostname()
@@ -79,8 +93,7 @@ def _acquire(path: Path, notice) -> int:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                raise LockError(f"{path.parent}: another `metricscenes generate` is writing this collection "
-                                f"({describe(_read(fd))}; lock file {path}); wait for it or stop it") from None
+                raise _refusal(path, _read(fd), command, what) from None
             try:  # the holder before us may have removed the file we opened: lock the one at `path`
                 same = os.fstat(fd).st_ino == os.stat(path).st_ino
             except FileNotFoundError:
@@ -91,13 +104,12 @@ def _acquire(path: Path, notice) -> int:
             previous = _read(fd)
             if previous and previous.get("pid") != os.getpid():
                 if previous.get("host") == host and _alive(previous):
-                    raise LockError(f"{path.parent}: another `metricscenes generate` is writing this collection "
-                                    f"({describe(previous)}; lock file {path}); wait for it or stop it")
+                    raise _refusal(path, previous, command, what)
                 if notice:
                     reason = "no longer running" if previous.get("host") == host else "its lock is not held"
                     notice(f"taking over the stale lock of {describe(previous)} ({reason})")
             me = {"pid": os.getpid(), "host": host, "process_start": _process_start(os.getpid()),
-                  "since": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "command": "metricscenes generate"}
+                  "since": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "command": command}
             os.ftruncate(fd, 0)
             os.pwrite(fd, (json.dumps(me) + "\n").encode(), 0)
             return fd
@@ -110,13 +122,20 @@ def _acquire(path: Path, notice) -> int:
     raise LockError(f"{path.parent}: could not take the lock {path} (it keeps being replaced)")
 
 
-@contextmanager
 def collection_lock(root: str | Path, notice=None):
     """Hold ``root/generate.lock`` for the duration of the block (``root`` must exist);
     raise :class:`LockError` if another writer holds it. ``notice`` gets one line when
     a stale lock is taken over."""
-    path = Path(root) / LOCK_FILE
-    fd = _acquire(path, notice)
+    return folder_lock(root, "metricscenes generate", "collection", notice=notice)
+
+
+@contextmanager
+def folder_lock(root: str | Path, command: str, what: str, notice=None, lock_file: str = LOCK_FILE):
+    """Hold ``root/lock_file`` for the duration of the block (``root`` must exist): one
+    ``command`` writing the folder (``what`` it is, for the message) at a time;
+    :class:`LockError`, one line naming the holder, if another holds it."""
+    path = Path(root) / lock_file
+    fd = _acquire(path, notice, command, what)
     try:
         yield path
     finally:

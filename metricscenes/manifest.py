@@ -128,6 +128,18 @@ class RenderSettings(_Strict):
         "many times coarser than the plates' (unset: the plates' grid); the reader interpolates it onto the plate's "
         "grid. The beams' footprint on the road is smooth and the lamps themselves are in the inset; see "
         "docs/performance.md, 'Car-lamp frames'")
+    plate_lamp: bool | None = Field(
+        None, description="light the car's rear registration plate at UN ECE R4's minimum luminance (2.5 cd/m² on a "
+        "white diffuser; a W5W lamp's spectrum) in light group car_lights (unset: an unlit plate); see "
+        "metricscenes.assets.lamps.plate_lamp")
+    rear_retroreflectors: bool | None = Field(
+        None, description="give the car its two red rear retro-reflectors (UN ECE R3 class IA), returning the ego low "
+        "beams' light to the camera in light group ego_lights (unset: none); see metricscenes.assets.retroreflection")
+    inset_shadow: bool | None = Field(
+        None, description="grow each inset's window over the car's shadow on the road, cast by the sun or moon of each "
+        "rendered sky that has one above the horizon (the plate has no car, so a shadow outside the window is "
+        "lost; unset: the car's box and margins only); see metricscenes.generate.inset_window and docs/scenes.md, "
+        "'The car's shadow'")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
     # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
@@ -204,6 +216,54 @@ class IlluminanceSweep(_Strict):
         return _unique(v, "light groups")
 
 
+class TargetedCondition(_Strict):
+    """A condition set by its mean image-plane illuminance through an ideal f/N lens: the
+    lamps at fixed weights, the ambient group scaled per scene to an environment's target,
+    drawn log-uniformly from ``target_image_plane_lux`` (:mod:`metricscenes.targets`)."""
+
+    ambient: Literal[PLATE_LIGHT_GROUPS]  # type: ignore[valid-type]
+    lamps: dict[str, Float] = {}
+    target_image_plane_lux: tuple[Float, Float]
+    f_number: Float = Field(2.4, gt=0.5, lt=64.0)
+
+    @field_validator("target_image_plane_lux")
+    @classmethod
+    def _range(cls, v: tuple[float, float]) -> tuple[float, float]:
+        lo, hi = v
+        if not (0.0 < lo <= hi < 2e5):
+            raise ValueError(f"target_image_plane_lux: [{lo:g}, {hi:g}] must be a range of lux with "
+                             "0 < low <= high < 200000")
+        return v
+
+    @field_validator("lamps")
+    @classmethod
+    def _lamp_weights(cls, v: dict[str, float]) -> dict[str, float]:
+        for group, w in v.items():
+            if not (0.0 <= w <= MAX_WEIGHT):
+                raise ValueError(f"lamps.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
+        return v
+
+    def groups(self) -> tuple[str, ...]:
+        return (self.ambient, *self.lamps)
+
+
+def _targeted(name: str, value):
+    """A condition given as a mapping with a target becomes a :class:`TargetedCondition`;
+    its errors name the condition, in one line."""
+    if not (isinstance(value, dict) and {"target_image_plane_lux", "ambient"} & set(value)):
+        return value
+    if "ambient" not in value:
+        raise ValueError(f"conditions.{name}: a target needs an ambient group to scale (ambient: <light group>)")
+    if "target_image_plane_lux" not in value:
+        raise ValueError(f"conditions.{name}: an ambient group needs target_image_plane_lux: [low, high]")
+    try:
+        return TargetedCondition.model_validate(value)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise ValueError(f"conditions.{name}.{where}: {first['msg']}") from None
+
+
 class Manifest(_Strict):
     """A collection definition (see docs/scenes.md, "The protocol")."""
 
@@ -216,7 +276,7 @@ class Manifest(_Strict):
     reference_grid: ReferenceGrid
     render: RenderSettings
     light_groups: tuple[Literal[LIGHT_GROUPS], ...] = Field(min_length=1)  # type: ignore[valid-type]
-    conditions: dict[str, dict[str, Float]] = Field(min_length=1)
+    conditions: dict[str, dict[str, Float] | TargetedCondition] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
     store: StoreSettings | None = None
 
@@ -224,6 +284,11 @@ class Manifest(_Strict):
     @classmethod
     def _groups_unique(cls, v: tuple[str, ...]) -> tuple[str, ...]:
         return _unique(v, "light groups")
+
+    @field_validator("conditions", mode="before")
+    @classmethod
+    def _targeted_conditions(cls, v):
+        return {name: _targeted(name, value) for name, value in v.items()} if isinstance(v, dict) else v
 
     @field_validator("conditions")
     @classmethod
@@ -249,6 +314,14 @@ class Manifest(_Strict):
     @model_validator(mode="after")
     def _conditions(self) -> "Manifest":
         for name, weights in self.conditions.items():
+            if isinstance(weights, TargetedCondition):
+                for group in weights.groups():
+                    if group not in self.light_groups:
+                        raise ValueError(f"conditions.{name}: light group {group!r} is not rendered "
+                                         f"(light_groups: {', '.join(self.light_groups)})")
+                if weights.ambient in weights.lamps:
+                    raise ValueError(f"conditions.{name}: {weights.ambient!r} is the ambient group and a lamp")
+                continue
             for group, w in weights.items():
                 if group not in self.light_groups:
                     raise ValueError(
@@ -263,6 +336,8 @@ class Manifest(_Strict):
         if sweep is not None:
             if sweep.base not in self.conditions:
                 raise ValueError(f"illuminance_sweep.base: {sweep.base!r} is not a condition")
+            if isinstance(self.conditions[sweep.base], TargetedCondition):
+                raise ValueError(f"illuminance_sweep.base: {sweep.base!r} is a targeted condition (give fixed weights)")
             if self.conditions[sweep.base].get(sweep.ambient_group, 0.0) <= 0.0:
                 raise ValueError(f"illuminance_sweep.ambient_group: {sweep.ambient_group!r} does not light "
                                  f"condition {sweep.base!r}")
@@ -361,7 +436,8 @@ def canonical_sha256(data) -> str:
 # sha256 (pinned by protocols and collections).
 HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "inset_feather"),
                         ("render", "ground_to_horizon"), ("render", "frame_divisor"), ("store", "mantissa_bits"),
-                        ("store", "spectral_basis"))
+                        ("store", "spectral_basis"), ("render", "plate_lamp"), ("render", "rear_retroreflectors"),
+                        ("render", "inset_shadow"))
 
 
 def manifest_sha256(data: dict) -> str:
@@ -378,6 +454,9 @@ def manifest_sha256(data: dict) -> str:
     return canonical_sha256(data)
 
 
+UNION_BRANCH_NAMES = ("dict[str,float]", "dict[str,Annotated[float, Strict]]", "TargetedCondition")
+
+
 def parse_manifest(data: object, source: str = "manifest") -> Manifest:
     """Validate an already-parsed mapping, raising :class:`ManifestError` on the first problem."""
     if not isinstance(data, dict):
@@ -387,7 +466,9 @@ def parse_manifest(data: object, source: str = "manifest") -> Manifest:
     except ValidationError as exc:
         err = exc.errors()[0]
         # a key with a newline or a NUL must not break the one-line message
-        where = ".".join(str(p) if str(p).isprintable() else repr(p) for p in err["loc"])
+        # (a condition is a union of weights and a targeted condition: pydantic names the branch)
+        loc = [p for p in err["loc"] if p not in UNION_BRANCH_NAMES]
+        where = ".".join(str(p) if str(p).isprintable() else repr(p) for p in loc)
         msg = err["msg"].removeprefix("Value error, ")
         # Cross-field checks already name their fields in the message.
         message = f"{source}: {where}: {msg}" if where else f"{source}: {msg}"

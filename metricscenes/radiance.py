@@ -7,6 +7,14 @@ whole reference field of view at the collection's reference sampling; the later 
 pasted over the plate. :meth:`SpectralScene.resample` turns the stack into a single
 uniform grid of any size (e.g. a camera's pixel grid): area averaging where a layer
 is finer than the grid (flux conserved), linear interpolation where it is coarser.
+
+Where the grid is finer than the plate, the plate is interpolated (blurred) while an
+inset is averaged (sharp): the window would show as a rectangle of sharper detail, with
+the camera's own demosaicking fringes on its horizon and lane markings only. An inset
+that carries a ``sharp`` map (the store's reader gives it one from the car's mask,
+:func:`car_sharpness`) keeps its own resolution only there, on the car and a few plate
+pixels around it, and elsewhere is shown at the plate's resolution: pasted onto the
+plate's grid first, then interpolated as the plate is (docs/scenes.md, "The inset seam").
 """
 
 from __future__ import annotations
@@ -30,11 +38,17 @@ class RadianceLayer:
         feather: for an inset, the share of its width (height) over which, along each
             edge inside the plate, its weight against the layer below rises linearly from
             0 to 1 (0: pasted with a hard edge). See :func:`feather_weights`.
+        sharp: for an inset, None (its own resolution everywhere: the composite of old)
+            or a (rows, cols) map in [0, 1] on its grid: where a target grid is finer than
+            the plate, 1 keeps the inset's resolution, 0 shows the inset at the plate's
+            (pasted onto the plate's grid, then interpolated as the plate is), so nothing
+            but the car is sharper than the plate around it. See :func:`car_sharpness`.
     """
 
     radiance: np.ndarray
     extent: TanExtent
     feather: float = 0.0
+    sharp: np.ndarray | None = None
 
     @property
     def pixel_tan(self) -> tuple[float, float]:
@@ -87,9 +101,14 @@ class SpectralScene:
         image, as the per-band optics wants it.
         """
         extent = extent or self.extent
-        out = _apply(*_weights(self.layers[0], cols, rows, extent), self.layers[0].radiance)
+        plate = self.layers[0]
+        out = _apply(*_weights(plate, cols, rows, extent), plate.radiance)
+        finer = (extent.width / cols < plate.pixel_tan[0] * (1 - 1e-9)
+                 and extent.height / rows < plate.pixel_tan[1] * (1 - 1e-9))
         for inset in self.layers[1:]:
             _paste(out, inset, cols, rows, extent, self.extent)
+            if inset.sharp is not None and finer:
+                _match_plate(out, inset, plate, cols, rows, extent)
         return out.transpose(1, 2, 0)
 
 
@@ -101,6 +120,31 @@ def on_grid_of(layer: RadianceLayer, target: RadianceLayer) -> np.ndarray:
     if layer.radiance.shape[:2] == (rows, cols) and layer.extent == target.extent:
         return layer.radiance
     return SpectralScene(layers=(layer,)).resample(cols, rows, target.extent)
+
+
+# How far the plate's resampling carries a plate cell's content: half a cell (its own area)
+# plus one cell (linear interpolation to the next centre). Within it, an inset shown at the
+# plate's resolution would smear the car over the road: :func:`car_sharpness` keeps it sharp.
+SHARP_CORE_PLATE_PX = 1.5
+# Beyond it, the inset's own resolution fades into the plate's over this many plate pixels.
+SHARP_RAMP_PLATE_PX = 2.0
+
+
+def car_sharpness(mask: np.ndarray, extent: TanExtent, plate_pixel_tan: tuple[float, float],
+                  core_px: float = SHARP_CORE_PLATE_PX, ramp_px: float = SHARP_RAMP_PLATE_PX) -> np.ndarray:
+    """An inset's ``sharp`` map (:class:`RadianceLayer`) from the car's instance mask over it:
+    1 within ``core_px`` plate pixels of the car, falling linearly to 0 over ``ramp_px`` more
+    (Euclidean distance in plate pixels; ``plate_pixel_tan`` is the plate's (x, y) pitch).
+    (rows, cols) float32 on the mask's (the inset's) grid; all 0 for an empty mask."""
+    from scipy.ndimage import distance_transform_edt
+
+    mask = np.asarray(mask, dtype=bool)
+    rows, cols = mask.shape
+    if not mask.any():
+        return np.zeros((rows, cols), np.float32)
+    sampling = (extent.height / rows / plate_pixel_tan[1], extent.width / cols / plate_pixel_tan[0])
+    distance = distance_transform_edt(~mask, sampling=sampling)
+    return np.clip((core_px + ramp_px - distance) / ramp_px, 0.0, 1.0).astype(np.float32)
 
 
 def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray, np.ndarray]:
@@ -134,11 +178,14 @@ def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray
 
 
 def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: TanExtent,
-           within: TanExtent) -> None:
+           within: TanExtent, *, weighted: bool = True) -> None:
     """Paste ``inset`` over band planes ``out`` (bands, rows, cols) in place: where the
     inset covers a target pixel its radiance replaces the plate's, blended by the area
     it covers times its feather weight (:func:`feather_weights`; ``within`` is the
-    plate's extent). Only the window the inset touches is computed."""
+    plate's extent). Only the window the inset touches is computed. ``weighted``: a
+    target pixel takes the feather-weighted mean of the inset pixels it overlaps (the
+    inset's detail, as it was pasted); else their plain mean, blended by their mean weight
+    (a pixel holds no detail finer than itself: :func:`_match_plate`'s cells)."""
     overlap_x = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1], extent.x0, extent.x1, cols)
     overlap_y = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0], extent.y0, extent.y1, rows)
     cover_x, cover_y = (np.asarray(m.sum(axis=1)).ravel() for m in (overlap_x, overlap_y))
@@ -149,12 +196,16 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
     wy, wx = _weights(inset, cols, rows, extent)
     if inset.feather > 0.0:
         feather_y, feather_x = feather_weights(inset, within)
-        weighted = inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None]
-        # Resampled weighted radiance over resampled weight: the feathered mean of the
-        # inset pixels a target pixel overlaps; it counts for their area times weight.
-        mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
-        values = _apply(wy[y_win], wx[x_win], weighted)
-        values *= np.divide(1.0, mean_weight, out=np.zeros_like(mean_weight), where=mean_weight > 0).astype(np.float32)
+        if weighted:
+            # Resampled weighted radiance over resampled weight: the feathered mean of the
+            # inset pixels a target pixel overlaps; it counts for their area times weight.
+            mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
+            values = _apply(wy[y_win], wx[x_win],
+                            inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None])
+            values *= np.divide(1.0, mean_weight, out=np.zeros_like(mean_weight),
+                                where=mean_weight > 0).astype(np.float32)
+        else:
+            values = _apply(wy[y_win], wx[x_win], inset.radiance)
         cover_x, cover_y = overlap_x @ feather_x, overlap_y @ feather_y
     else:
         values = _apply(wy[y_win], wx[x_win], inset.radiance)
@@ -163,6 +214,56 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
     window *= (1.0 - coverage).astype(np.float32)
     values *= coverage.astype(np.float32)
     window += values
+
+
+def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, cols: int, rows: int,
+                 extent: TanExtent) -> None:
+    """Where ``out`` (band planes, a grid finer than the plate's, already holding the inset
+    pasted at its own resolution) lies near the inset, show the inset at the plate's
+    resolution except where ``inset.sharp`` keeps its own: the inset is pasted (its mean over
+    each cell, blended by the cell's mean feather weight) onto the plate's own cells around
+    it, which are then interpolated onto the grid exactly as the plate is (low);
+    out = low + sharp · (out - low). Away from the
+    inset the cells are the plate's, so nothing changes there, and at the window's border
+    the composite has the plate's resolution on both sides: no step."""
+    e, (plate_rows, plate_cols) = plate.extent, plate.radiance.shape[:2]
+    ppx, ppy = e.width / plate_cols, e.height / plate_rows
+    i = inset.extent
+    margin = 2  # plate cells kept around those the inset touches (linear interpolation reads one)
+    j0 = max(0, int(np.floor((i.x0 - e.x0) / ppx + 1e-9)) - margin)
+    j1 = min(plate_cols, int(np.ceil((i.x1 - e.x0) / ppx - 1e-9)) + margin)
+    r0 = max(0, int(np.floor((i.y0 - e.y0) / ppy + 1e-9)) - margin)
+    r1 = min(plate_rows, int(np.ceil((i.y1 - e.y0) / ppy - 1e-9)) + margin)
+    if j1 <= j0 or r1 <= r0:
+        return
+    cells = TanExtent(e.x0 + j0 * ppx, e.y0 + r0 * ppy, e.x0 + j1 * ppx, e.y0 + r1 * ppy)
+    low_cells = np.ascontiguousarray(np.moveaxis(plate.radiance[r0:r1, j0:j1], 2, 0), dtype=np.float32)
+    _paste(low_cells, inset, j1 - j0, r1 - r0, cells, e, weighted=False)
+    # The grid's pixels whose centres have both neighbouring cell centres among these cells
+    # (on the plate's border the plate clamps as these cells do): there, low is defined.
+    tpx, tpy = extent.width / cols, extent.height / rows
+    lo_x = cells.x0 + (ppx if j0 > 0 else -np.inf)
+    hi_x = cells.x1 - (ppx if j1 < plate_cols else -np.inf)
+    lo_y = cells.y0 + (ppy if r0 > 0 else -np.inf)
+    hi_y = cells.y1 - (ppy if r1 < plate_rows else -np.inf)
+    c0 = max(0, int(np.ceil((lo_x - extent.x0) / tpx - 0.5))) if np.isfinite(lo_x) else 0
+    c1 = min(cols, int(np.floor((hi_x - extent.x0) / tpx - 0.5)) + 1) if np.isfinite(hi_x) else cols
+    y0 = max(0, int(np.ceil((lo_y - extent.y0) / tpy - 0.5))) if np.isfinite(lo_y) else 0
+    y1 = min(rows, int(np.floor((hi_y - extent.y0) / tpy - 0.5)) + 1) if np.isfinite(hi_y) else rows
+    if c1 <= c0 or y1 <= y0:
+        return
+    region = TanExtent(extent.x0 + c0 * tpx, extent.y0 + y0 * tpy, extent.x0 + c1 * tpx, extent.y0 + y1 * tpy)
+    low_layer = RadianceLayer(np.moveaxis(low_cells, 0, 2), cells)
+    low = _apply(*_weights(low_layer, c1 - c0, y1 - y0, region), low_layer.radiance)
+    # The share of each pixel's area that keeps the inset's own resolution (0 off the inset).
+    n_rows, n_cols = inset.radiance.shape[:2]
+    ox = _overlap_matrix(i.x0, i.x1, n_cols, region.x0, region.x1, c1 - c0)
+    oy = _overlap_matrix(i.y0, i.y1, n_rows, region.y0, region.y1, y1 - y0)
+    sharp = np.asarray(oy @ (ox @ np.asarray(inset.sharp, dtype=np.float64).T).T, dtype=np.float32)
+    window = out[:, y0:y1, c0:c1]
+    window -= low
+    window *= sharp
+    window += low
 
 
 def _weights(layer: RadianceLayer, cols: int, rows: int, extent: TanExtent) -> tuple[sp.csr_matrix, sp.csr_matrix]:

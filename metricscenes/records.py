@@ -1,8 +1,8 @@
 """What a collection records of its own making, typed, and the exact bytes it is stored as.
 
 - :class:`UnitRecord` is ``progress/<unit>.json``: one per finished unit of work (a plate
-  or an inset), the sha256 of every array it wrote and what the ground truth and the
-  resolved manifest take from it. The writer writes it (:mod:`metricscenes.writer`);
+  or an inset), the sha256 of every array it wrote (and of each array's attributes) and
+  what the ground truth and the resolved manifest take from it. The writer writes it (:mod:`metricscenes.writer`);
   a rerun of ``generate`` reads it back to resume.
 - :class:`ResolvedManifest` is ``manifest.resolved.yaml``: the manifest as run and what
   its making recorded (array hashes, illuminances, the plan, the variant, its own hashes).
@@ -72,9 +72,14 @@ class UnitRecord:
     # Plates: horizontal illuminance at the camera per light group (None: no group lit the plate).
     illuminance_lux: dict[str, float] | None = None
     inset: InsetTruth | None = None  # insets (stored flat, beside the fields above)
+    # Every array -> sha256 of its attributes (store.attributes_sha256); None in records
+    # written before they were recorded.
+    attributes: dict[str, str] | None = None
 
     def to_json(self) -> str:
         data = {"unit": self.unit, "kind": self.kind, "arrays": self.arrays, "seconds": self.seconds}
+        if self.attributes is not None:
+            data["attributes"] = self.attributes
         if self.illuminance_lux is not None:
             data["illuminance_lux"] = self.illuminance_lux
         if self.inset is not None:
@@ -89,16 +94,17 @@ class UnitRecord:
         if not isinstance(unit, str) or kind not in (PLATE, INSET) or not _is_number(seconds):
             raise RecordError("unit, kind or seconds")
         arrays = _mapping(data, "arrays", lambda v: isinstance(v, str))
+        attributes = None if "attributes" not in data else _mapping(data, "attributes", lambda v: isinstance(v, str))
         if kind == PLATE:
             illuminance = None if "illuminance_lux" not in data else _mapping(data, "illuminance_lux", _is_number)
-            return cls(unit, kind, arrays, seconds, illuminance_lux=illuminance)
+            return cls(unit, kind, arrays, seconds, illuminance_lux=illuminance, attributes=attributes)
         scale, iou = data.get("inset_scale"), data.get("mask_iou")
         if not (isinstance(scale, int) and not isinstance(scale, bool) and _is_number(iou)):
             raise RecordError("inset_scale or mask_iou")
         inset = InsetTruth(pose=_mapping(data, "pose", _is_number), projected_box_tan=_box(data, "projected_box_tan"),
                            inset_scale=scale, box_tan=_box(data, "box_tan"), mask_iou=iou,
                            bbox_xywh=_box(data, "bbox_xywh"))
-        return cls(unit, kind, arrays, seconds, inset=inset)
+        return cls(unit, kind, arrays, seconds, inset=inset, attributes=attributes)
 
 
 def resolved_content_sha256(resolved: dict) -> str:
@@ -110,7 +116,7 @@ def resolved_content_sha256(resolved: dict) -> str:
 class ResolvedManifest:
     """``manifest.resolved.yaml``: the manifest as run and what its making recorded.
 
-    The three last fields are absent (None) in collections made before they were recorded."""
+    The four last fields are absent (None) in collections made before they were recorded."""
 
     package_version: str | None  # of metricscenes, when it was written
     manifest_sha256: str
@@ -122,14 +128,16 @@ class ResolvedManifest:
     render_variant: str | None = None  # the Mitsuba variant that rendered the arrays (render.variant: auto resolved)
     groundtruth_sha256: str | None = None  # of groundtruth.json's bytes
     content_sha256: str | None = None  # over all of the above (resolved_content_sha256)
+    # Every array (masks too) -> sha256 of its attributes (store.attributes_sha256).
+    attributes_sha256: dict[str, str] | None = None
 
     def as_dict(self) -> dict:
         """The file's mapping, in the file's order; fields that are None are left out."""
         data = {"package_version": self.package_version, "manifest_sha256": self.manifest_sha256,
                 "manifest": self.manifest_json, "render_variant": self.render_variant, "arrays": self.arrays,
-                "illuminance_lux": self.illuminance_lux, "plan": self.plan,
-                "groundtruth_sha256": self.groundtruth_sha256, "content_sha256": self.content_sha256}
-        optional = ("package_version", "render_variant", "groundtruth_sha256", "content_sha256")
+                "attributes_sha256": self.attributes_sha256, "illuminance_lux": self.illuminance_lux,
+                "plan": self.plan, "groundtruth_sha256": self.groundtruth_sha256, "content_sha256": self.content_sha256}
+        optional = ("package_version", "render_variant", "attributes_sha256", "groundtruth_sha256", "content_sha256")
         return {k: v for k, v in data.items() if v is not None or k not in optional}
 
     def to_yaml(self) -> str:
@@ -143,4 +151,4 @@ class ResolvedManifest:
                    manifest_json=data["manifest"], arrays=data["arrays"],
                    illuminance_lux=data.get("illuminance_lux", {}), plan=data.get("plan", []),
                    render_variant=data.get("render_variant"), groundtruth_sha256=data.get("groundtruth_sha256"),
-                   content_sha256=data.get("content_sha256"))
+                   content_sha256=data.get("content_sha256"), attributes_sha256=data.get("attributes_sha256"))

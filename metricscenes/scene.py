@@ -55,8 +55,13 @@ def environment_parts(env: EnvironmentPlan, ground_to_horizon: bool = False) -> 
     return road.merged(ego_vehicle.ego_lamp_parts())
 
 
-def car_parts(env: EnvironmentPlan, pose: CarPose) -> SceneParts:
-    return cars.car_parts(cars.car_spec(env.car_id), (pose.x_m, pose.y_m), pose.yaw_rad)
+def car_parts(env: EnvironmentPlan, pose: CarPose, *, plate_lamp: bool = False,
+              rear_retroreflectors: bool = False) -> SceneParts:
+    """The environment's car at ``pose``, with its lit rear plate and its rear
+    retro-reflectors where asked (:func:`metricscenes.assets.cars.car_parts`; the manifest's
+    ``render.plate_lamp`` and ``render.rear_retroreflectors``)."""
+    return cars.car_parts(cars.car_spec(env.car_id), (pose.x_m, pose.y_m), pose.yaw_rad,
+                          plate_lamp=plate_lamp, rear_retroreflectors=rear_retroreflectors)
 
 
 def car_vertices(env: EnvironmentPlan, pose: CarPose) -> np.ndarray:

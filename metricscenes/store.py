@@ -13,8 +13,8 @@ Layout of a collection folder::
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, the Mitsuba variant that
-                                        rendered it, sha256 of every array (masks too), of
-                                        groundtruth.json and of its own content
+                                        rendered it, sha256 of every array (masks too) and of its
+                                        attributes, of groundtruth.json and of its own content
     progress/<unit>.json                one record per finished unit of work (resume)
     progress/manifest_sha256            what the records were made from (a resume of another
     progress/render_variant             manifest, or with another variant, is refused)
@@ -35,9 +35,13 @@ decoded 31 bands (:mod:`metricscenes.spectral_basis`), so no reader sees the dif
 
 Integrity: every array is checked against its recorded sha256 when it is first read
 (once per process and file version, :func:`read_checked`), so a damaged, truncated or
-deleted chunk is an error, never wrong numbers or fill-value zeros. Collections written
-before masks and ground truth had a sha256 are still read: their ground-truth boxes are
-recomputed from the masks instead.
+deleted chunk is an error, never wrong numbers or fill-value zeros; its attributes (the
+extent, units, wavelengths, spectral basis: everything a reader takes from its
+``zarr.json``) against the sha256 of their canonical JSON (:func:`attributes_sha256`) each
+time they are read, so a moved ``extent_tan`` is an error too. Collections written before
+masks and ground truth had a sha256 are still read: their ground-truth boxes are recomputed
+from the masks instead; those written before attributes had one are read unchecked, and
+``verify`` says how to record them (:func:`upgrade_notes`).
 """
 
 from __future__ import annotations
@@ -54,11 +58,15 @@ import yaml
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.manifest import (
-    Manifest, ManifestError, illuminance_condition, manifest_sha256, parse_illuminance_condition, parse_manifest,
+    Manifest, ManifestError, TargetedCondition, canonical_sha256, illuminance_condition, manifest_sha256,
+    parse_illuminance_condition, parse_manifest,
 )
-from metricscenes.radiance import RadianceLayer, SpectralScene, on_grid_of
+from metricscenes.radiance import RadianceLayer, SpectralScene, car_sharpness, on_grid_of
 from metricscenes.records import ResolvedManifest, resolved_content_sha256
 from metricscenes.spectral_basis import decode
+from metricscenes.targets import TargetedWeights, ambient_weight, draw_target_lux
+
+_GROUP_LUMINANCE: dict[tuple, float] = {}  # mean luminance of a scene's light group, per version of its files
 
 RADIANCE_STORE = "radiance.zarr"
 GROUNDTRUTH_FILE = "groundtruth.json"
@@ -66,6 +74,9 @@ RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
 PROGRESS_DIR = "progress"
 DIMENSIONS = ("y", "x", "wavelength")
 REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
+ATTRIBUTES_UPGRADE_NOTE = ("its arrays' attributes have no recorded sha256 (the collection was written before they "
+                           "had one): rerun `metricscenes generate` with its manifest to record them (it renders "
+                           "nothing when they are the ones written)")
 
 
 class CollectionError(ValueError):
@@ -85,6 +96,20 @@ def array_sha256(array: np.ndarray) -> str:
     return h.hexdigest()
 
 
+def attributes_sha256(attributes: dict) -> str:
+    """sha256 of an array's attributes as its ``zarr.json`` holds them (canonical JSON:
+    sorted keys, no spaces), the same for the dict written and the one read back."""
+    return canonical_sha256(attributes)
+
+
+def check_attributes(attributes: dict, expected: str | None, label: str, path: str) -> None:
+    """Raise :class:`CollectionError` if ``attributes`` are not the ones whose sha256 is
+    ``expected`` (None: not recorded, in collections written before it was)."""
+    if expected is not None and attributes_sha256(attributes) != expected:
+        raise CollectionError(f"{label}: {path} attributes do not match their sha256 (its zarr.json was edited "
+                              "or damaged)")
+
+
 def _fingerprint(root: Path, path: str) -> tuple:
     """What identifies one version of an array's files: names, inodes, sizes, mtimes."""
     folder = root / RADIANCE_STORE / path
@@ -96,13 +121,16 @@ def _fingerprint(root: Path, path: str) -> tuple:
     return (str(folder.resolve()), *files)
 
 
-def read_checked(root: Path, group, path: str, expected: str | None, label: str) -> tuple[np.ndarray, dict]:
+def read_checked(root: Path, group, path: str, expected: str | None, label: str,
+                 expected_attributes: str | None = None) -> tuple[np.ndarray, dict]:
     """Read one array of a collection and its attributes; check it against ``expected``
-    (its recorded sha256; None for masks of older collections, which have none).
+    (its recorded sha256; None for masks of older collections, which have none) and its
+    attributes against ``expected_attributes`` (:func:`attributes_sha256`; None for
+    collections written before it was recorded).
 
     Raises :class:`CollectionError` ``"<label>: <path> <what is wrong>"`` if the array is
     missing, unreadable, or not the bytes that were written (a deleted chunk reads as
-    fill values, so it fails the hash too).
+    fill values, so it fails the hash too), or if its attributes were changed.
     """
     import zarr
 
@@ -120,6 +148,7 @@ def read_checked(root: Path, group, path: str, expected: str | None, label: str)
         attrs = dict(node.attrs)
     except Exception as exc:  # zstd, numcodecs and zarr raise many types for a damaged chunk
         raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
+    basis = None
     if "spectral_basis" in attrs:  # K coefficients per pixel: the radiance is decoded (store.spectral_basis)
         try:
             basis = np.asarray(attrs["spectral_basis"], dtype=np.float64)
@@ -128,6 +157,8 @@ def read_checked(root: Path, group, path: str, expected: str | None, label: str)
         bands = len(attrs.get("wavelengths_nm") or ())
         if basis is None or basis.ndim != 2 or data.ndim != 3 or basis.shape != (data.shape[-1], bands):
             raise CollectionError(f"{label}: {path} is unreadable (its spectral_basis does not fit its coefficients)")
+    check_attributes(attrs, expected_attributes, label, path)  # (after the basis' shape: the more telling error)
+    if basis is not None:
         data = decode(data, basis.T)
     if expected is not None and fingerprint not in _CHECKED:
         if array_sha256(data) != expected:
@@ -304,15 +335,20 @@ class Collection:
         levels = [illuminance_condition(sweep.base, lux) for lux in sweep.levels_lux] if sweep else []
         return list(self.conditions) + levels
 
-    def _weights(self, condition: str | dict[str, float], environment_id: int) -> dict[str, float]:
+    def _weights(self, condition: str | dict[str, float], scene_id: str) -> dict[str, float]:
+        """Light-group weights of a condition in one scene (a targeted condition's depend on
+        the scene: :meth:`targeted_weights`)."""
         if not isinstance(condition, str):
             return dict(condition)
         if condition not in self.condition_names:
             raise CollectionError(
                 f"unknown condition {condition!r} (this collection has: {', '.join(self.condition_names)})"
             )
+        if isinstance(self.conditions.get(condition), TargetedCondition):
+            return self.targeted_weights(scene_id, condition).weights
         if condition in self.conditions:
             return dict(self.conditions[condition])
+        environment_id = self._image(scene_id)["environment_id"]
         sweep = self.manifest.illuminance_sweep
         _, level = parse_illuminance_condition(condition)
         weights = dict(self.conditions[sweep.base])
@@ -330,32 +366,79 @@ class Collection:
         measured values, weighted (car lamps not included: they face the road)."""
         env = self._image(scene_id)["environment_id"]
         measured = self.resolved.illuminance_lux[f"env{env:03d}"]
-        return float(sum(w * measured.get(g, 0.0) for g, w in self._weights(condition, env).items()))
+        return float(sum(w * measured.get(g, 0.0) for g, w in self._weights(condition, scene_id).items()))
+
+    def mean_luminance(self, scene_id: str, condition: str | dict[str, float]) -> float:
+        """Mean luminance (cd/m²) of a scene under a condition over the field of view, on the
+        reference grid (what a lens images: plate, frame and inset composited)."""
+        from metricscenes.photometry import radiance_to_xyz
+
+        cols, rows = self.reference_grid
+        return float(radiance_to_xyz(self.radiance(scene_id, condition).resample(cols, rows))[..., 1].mean())
+
+    def _group_luminance(self, scene_id: str, group: str) -> float:
+        """:meth:`mean_luminance` of one light group at weight 1, kept per version of its files."""
+        units = (f"plates/env{self._image(scene_id)['environment_id']:03d}", f"frames/{scene_id}", f"insets/{scene_id}")
+        key = (str(self.root), scene_id, group,
+               tuple(_fingerprint(self.root, f"{unit}/{group}") for unit in units if group in self._recorded.get(unit, [])))
+        if key not in _GROUP_LUMINANCE:
+            _GROUP_LUMINANCE[key] = self.mean_luminance(scene_id, {group: 1.0})
+        return _GROUP_LUMINANCE[key]
+
+    def targeted_weights(self, scene_id: str, condition: str) -> TargetedWeights:
+        """A targeted condition's weights in one scene: its environment's target drawn from
+        the condition's range, the ambient weight that meets it (:mod:`metricscenes.targets`)."""
+        spec = self.conditions[condition]
+        env = self._image(scene_id)["environment_id"]
+        target = draw_target_lux(self.manifest.seed, env, condition, spec.target_image_plane_lux)
+        lamps = {g: w for g, w in spec.lamps.items() if w != 0.0}
+        try:
+            return ambient_weight(target, spec.f_number, self._group_luminance(scene_id, spec.ambient),
+                                  {g: self._group_luminance(scene_id, g) for g in lamps}, lamps, spec.ambient)
+        except ValueError as exc:
+            raise CollectionError(f"{self.root}: scene {scene_id}, condition {condition}: {exc}") from None
+
+    def condition_record(self, scene_id: str, condition: str) -> dict | None:
+        """What a targeted condition did in a scene (target, weights, over target), else None."""
+        if isinstance(condition, str) and isinstance(self.conditions.get(condition), TargetedCondition):
+            return self.targeted_weights(scene_id, condition).record()
+        return None
 
     def photometry(self, scene_id: str, condition: str | dict[str, float], f_number: float = 2.4) -> dict:
         """Horizontal illuminance at the camera, mean scene luminance over the field of
         view, and the mean image-plane illuminance of an ideal f/N lens."""
-        from metricscenes.photometry import image_plane_illuminance_lux, radiance_to_xyz
+        from metricscenes.photometry import image_plane_illuminance_lux
 
-        cols, rows = self.reference_grid
-        luminance = float(radiance_to_xyz(self.radiance(scene_id, condition).resample(cols, rows))[..., 1].mean())
-        return {
+        luminance = self.mean_luminance(scene_id, condition)
+        out = {
             "scene_id": scene_id, "condition": condition if isinstance(condition, str) else dict(condition),
             "illuminance_at_camera_lux": self.illuminance_lux(scene_id, condition),
             "mean_luminance_cd_m2": luminance,
             "f_number": f_number,
             "image_plane_illuminance_lux": image_plane_illuminance_lux(luminance, f_number),
         }
+        targeted = self.condition_record(scene_id, condition)
+        if targeted is not None:
+            out["targeted"] = targeted
+        return out
 
     def _image(self, scene_id: str) -> dict:
         if scene_id not in self._images:
             raise CollectionError(f"unknown scene {scene_id!r}")
         return self._images[scene_id]
 
+    def _expected_attributes(self, path: str) -> str | None:
+        """The recorded sha256 of an array's attributes (None: the collection predates them;
+        "": it records them, but not this array's, which then fails the check)."""
+        recorded = self.resolved.attributes_sha256
+        return None if recorded is None else recorded.get(path, "")
+
     def _read(self, path: str, scene_id: str) -> tuple[np.ndarray, dict]:
-        """One array, checked against its recorded sha256 (a one-line error naming the scene)."""
+        """One array, checked against its recorded sha256 and its attributes against theirs
+        (a one-line error naming the scene)."""
         try:
-            return read_checked(self.root, self._group(), path, self.resolved.arrays.get(path), f"scene {scene_id}")
+            return read_checked(self.root, self._group(), path, self.resolved.arrays.get(path), f"scene {scene_id}",
+                                self._expected_attributes(path))
         except CollectionError as exc:
             raise CollectionError(f"{self.root}: {exc}; {REPAIR_HINT}") from None
 
@@ -395,11 +478,18 @@ class Collection:
         return layer
 
     def _node(self, path: str, scene_id: str):
-        """An array's metadata (shape, attributes) without reading its data."""
+        """An array's metadata (shape, attributes) without reading its data; its attributes
+        checked against their recorded sha256."""
         try:
-            return self._group()[path]
+            node = self._group()[path]
+            attrs = dict(node.attrs)
         except Exception:
             raise CollectionError(f"{self.root}: scene {scene_id}: {path} is missing or unreadable; {REPAIR_HINT}") from None
+        try:
+            check_attributes(attrs, self._expected_attributes(path), f"scene {scene_id}", path)
+        except CollectionError as exc:
+            raise CollectionError(f"{self.root}: {exc}; {REPAIR_HINT}") from None
+        return node
 
     def mask(self, scene_id: str) -> tuple[np.ndarray, TanExtent]:
         """The car's instance mask over its inset window and that window's extent, checked
@@ -416,19 +506,28 @@ class Collection:
     def _groundtruth_problems(self) -> list[str]:
         return groundtruth_problems(self.root, self._group(), self._groundtruth, self._groundtruth_sha256, self.resolved)
 
-    def radiance(self, scene_id: str, condition: str | dict[str, float]) -> SpectralScene:
+    def radiance(self, scene_id: str, condition: str | dict[str, float], *,
+                 inset_resolution: str = "car") -> SpectralScene:
         """The scene's spectral radiance under a condition (a name from the manifest, or
         light-group weights): the plate and the car's inset, each the weighted sum of its
-        light groups' renders."""
+        light groups' renders. ``inset_resolution``: where a grid is finer than the plate,
+        ``"car"`` keeps the inset's own resolution on the car and shows the rest of its
+        window at the plate's, so the window leaves no seam (:func:`metricscenes.radiance.car_sharpness`);
+        ``"window"`` keeps it over the whole window (the composite before; docs/scenes.md,
+        "The inset seam")."""
+        if inset_resolution not in ("car", "window"):
+            raise ValueError(f"inset_resolution must be 'car' or 'window', not {inset_resolution!r}")
         img = self._image(scene_id)
-        weights = self._weights(condition, img["environment_id"])
-        self.mask(scene_id)  # a scene is read whole or not at all: its mask and box too
+        weights = self._weights(condition, scene_id)
+        mask, _ = self.mask(scene_id)  # a scene is read whole or not at all: its mask and box too
         plate = self._mix("plates", f"env{img['environment_id']:03d}", weights, scene_id)
         frame = self._mix("frames", scene_id, weights, scene_id, required=False)
         if frame is not None:
             plate = RadianceLayer(plate.radiance + on_grid_of(frame, plate), plate.extent)
         inset = replace(self._mix("insets", scene_id, weights, scene_id),
                         feather=self.manifest.render.inset_feather or 0.0)
+        if inset_resolution == "car" and mask.shape == inset.radiance.shape[:2]:
+            inset = replace(inset, sharp=car_sharpness(mask, inset.extent, plate.pixel_tan))
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
         return SpectralScene(
             layers=layers,
@@ -537,6 +636,10 @@ def _load_resolved(root: Path) -> ResolvedManifest:
     content = resolved.get("content_sha256")  # absent in collections written before it
     if content is not None and content != resolved_content_sha256(resolved):
         raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} does not match its content_sha256 (edited or damaged)")
+    attributes = resolved.get("attributes_sha256")  # absent in collections written before it
+    if attributes is not None and not (isinstance(attributes, dict)
+                                       and all(isinstance(v, str) for v in attributes.values())):
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: attributes_sha256 is not a mapping of hashes")
     return ResolvedManifest.from_dict(resolved)
 
 
@@ -566,23 +669,36 @@ def _load_groundtruth(root: Path) -> tuple[dict, str]:
     return groundtruth, hashlib.sha256(raw).hexdigest()
 
 
-def _progress_arrays(root: Path) -> dict[str, str]:
-    """The array hashes the progress records hold (what verify falls back on when the
-    resolved manifest is unusable)."""
-    arrays = {}
+def _progress_arrays(root: Path) -> tuple[dict[str, str], dict[str, str]]:
+    """The array hashes and attribute hashes the progress records hold (what verify falls
+    back on when the resolved manifest is unusable)."""
+    arrays, attributes = {}, {}
     for record in sorted((root / PROGRESS_DIR).glob("*.json")):
         try:
-            arrays.update(json.loads(record.read_text())["arrays"])
-        except (OSError, ValueError, KeyError, TypeError):
+            data = json.loads(record.read_text())
+            arrays.update(data["arrays"])
+            attributes.update(data.get("attributes") or {})
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
             continue
-    return arrays
+    return arrays, attributes
+
+
+def upgrade_notes(path: str | Path) -> list[str]:
+    """What an intact collection written by an older version does not record yet, and how to
+    record it (one line each): its arrays' attribute hashes."""
+    try:
+        resolved = _load_resolved(Path(path))
+    except CollectionError:
+        return []
+    return [ATTRIBUTES_UPGRADE_NOTE] if resolved.attributes_sha256 is None and resolved.arrays else []
 
 
 def verify_collection(path: str | Path) -> list[str]:
     """Check a whole collection; return every problem, one line each naming its scene
     (plates: their environment): the resolved manifest (parses, manifest and content
     hashes), every recorded array (sha256; masks too), and the ground truth (sha256, plan,
-    boxes recomputed from the masks). Empty: nothing is wrong."""
+    boxes recomputed from the masks), every array's attributes (their recorded sha256,
+    where the collection records them). Empty: nothing is wrong."""
     import zarr
 
     root = Path(path)
@@ -599,7 +715,12 @@ def verify_collection(path: str | Path) -> list[str]:
         groundtruth = _load_groundtruth(root)
     except CollectionError as exc:
         problems.append(str(exc).removeprefix(f"{root}: "))
-    expected = resolved.arrays if resolved is not None else _progress_arrays(root)
+    if resolved is not None:
+        expected, attributes = resolved.arrays, resolved.attributes_sha256
+        fallback = ""  # it records them: an array it lists without them fails the check
+    else:
+        expected, attributes = _progress_arrays(root)
+        fallback = None  # what the records hold; older records hold none
     if not expected:
         problems.append("no recorded array hashes to check (manifest.resolved.yaml and progress/ are unusable)")
     try:
@@ -610,7 +731,8 @@ def verify_collection(path: str | Path) -> list[str]:
         kind, _, rest = array_path.partition("/")
         unit = rest.split("/")[0]
         try:
-            read_checked(root, group, array_path, sha, f"environment {unit}" if kind == "plates" else f"scene {unit}")
+            read_checked(root, group, array_path, sha, f"environment {unit}" if kind == "plates" else f"scene {unit}",
+                         None if attributes is None else attributes.get(array_path, fallback))
         except CollectionError as exc:
             problems.append(str(exc))
     if groundtruth is not None:  # without a usable resolved manifest, boxes are still checked against the masks

@@ -45,6 +45,7 @@ from metricscenes.records import PLATE, ResolvedManifest, UnitRecord, resolved_c
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
 from metricscenes.store import (
     DIMENSIONS, GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, RESOLVED_MANIFEST_FILE, CollectionError, array_sha256,
+    attributes_sha256,
 )
 
 MANIFEST_STAMP = "manifest_sha256"
@@ -98,6 +99,35 @@ def stored_form(cube: np.ndarray, mantissa_bits: int | None, spectral_basis_k: i
     return stored, basis
 
 
+def radiance_attributes(light_group: str, extent: TanExtent, mantissa_bits: int | None,
+                        basis_attribute: list | None, extra_attrs: dict | None = None) -> dict:
+    """The attributes of a radiance array (``basis_attribute``: its ``spectral_basis``, K
+    lists of 31, or None for 31 bands): what :meth:`UnitArrays.write_radiance` writes, and
+    what ``generate`` expects of arrays written before their attributes had a sha256."""
+    return {
+        "units": RADIANCE_UNITS,
+        "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
+        "extent_tan": list(extent.as_tuple()),
+        "light_group": light_group,
+        **({} if mantissa_bits is None else {"mantissa_bits": mantissa_bits}),
+        **({} if basis_attribute is None else {"spectral_basis": basis_attribute}),
+        **(extra_attrs or {}),
+    }
+
+
+def mask_attributes(extent: TanExtent) -> dict:
+    """The attributes of an inset's mask (see :func:`radiance_attributes`)."""
+    return {"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"}
+
+
+def _stored_attributes_sha256(root: Path, path: str) -> str:
+    """sha256 of an array's attributes as its ``zarr.json`` now holds them (read back, so the
+    hash is of what every reader will see)."""
+    import zarr
+
+    return attributes_sha256(dict(zarr.open_array(store=str(root / RADIANCE_STORE), path=path, mode="r").attrs))
+
+
 def read_back(stored: np.ndarray, basis: np.ndarray | None) -> np.ndarray:
     """The 31 bands a reader gets back of :func:`stored_form`'s values (what an array's
     sha256 is of)."""
@@ -109,7 +139,8 @@ def read_back(stored: np.ndarray, basis: np.ndarray | None) -> np.ndarray:
 class UnitArrays:
     """The arrays of one unit of work, written by the process that renders it: its radiance
     per light group (``<kind>/<unit>/<light_group>``) and, for an inset, the car's mask
-    (``masks/<unit>``). :attr:`sha256` collects what was written, for the unit's record."""
+    (``masks/<unit>``). :attr:`sha256` collects what was written and :attr:`attributes_sha256`
+    its attributes' hashes, for the unit's record."""
 
     def __init__(self, root: str | Path, unit: str, mantissa_bits: int | None = None,
                  spectral_basis: int | None = None):
@@ -118,6 +149,7 @@ class UnitArrays:
         self.mantissa_bits = mantissa_bits  # the manifest's store.mantissa_bits; None: lossless
         self.spectral_basis = spectral_basis  # store.spectral_basis: K basis spectra per array; None: 31 bands
         self.sha256: dict[str, str] = {}
+        self.attributes_sha256: dict[str, str] = {}
 
     def write_radiance(self, kind: str, light_group: str, cube: np.ndarray, extent: TanExtent,
                        extra_attrs: dict | None = None) -> str:
@@ -134,15 +166,8 @@ class UnitArrays:
         from metricscenes import spectral_basis
 
         stored, basis = stored_form(cube, self.mantissa_bits, self.spectral_basis)
-        attrs = {
-            "units": RADIANCE_UNITS,
-            "wavelengths_nm": [float(w) for w in WAVELENGTHS_NM],
-            "extent_tan": list(extent.as_tuple()),
-            "light_group": light_group,
-            **({} if self.mantissa_bits is None else {"mantissa_bits": self.mantissa_bits}),
-            **({} if basis is None else {"spectral_basis": basis.T.tolist()}),
-            **(extra_attrs or {}),
-        }
+        attrs = radiance_attributes(light_group, extent, self.mantissa_bits,
+                                    None if basis is None else basis.T.tolist(), extra_attrs)
         path = f"{kind}/{self.unit}/{light_group}"
         arr = zarr.create_array(
             store=str(self.root / RADIANCE_STORE), name=path, shape=stored.shape, dtype="float32", chunks=stored.shape,
@@ -153,6 +178,7 @@ class UnitArrays:
         )
         arr[...] = stored
         self.sha256[path] = array_sha256(read_back(stored, basis))
+        self.attributes_sha256[path] = _stored_attributes_sha256(self.root, path)
         return self.sha256[path]
 
     def write_mask(self, mask: np.ndarray, extent: TanExtent) -> str:
@@ -164,10 +190,11 @@ class UnitArrays:
         arr = zarr.create_array(
             store=str(self.root / RADIANCE_STORE), name=path, shape=mask.shape, dtype="bool",
             chunks=mask.shape, dimension_names=("y", "x"), overwrite=True, config=WRITE_CONFIG,
-            attributes={"extent_tan": list(extent.as_tuple()), "meaning": "car instance mask"},
+            attributes=mask_attributes(extent),
         )
         arr[...] = mask
         self.sha256[path] = array_sha256(mask)
+        self.attributes_sha256[path] = _stored_attributes_sha256(self.root, path)
         return self.sha256[path]
 
 
@@ -281,6 +308,9 @@ class CollectionWriter:
             manifest_json=manifest.model_dump(mode="json"),
             render_variant=variant,
             arrays={path: sha for key in sorted(records) for path, sha in sorted(records[key].arrays.items())},
+            # (None if a record predates them: generate records them first, so this is for callers of old records)
+            attributes_sha256=None if any(r.attributes is None for r in records.values()) else {
+                path: sha for key in sorted(records) for path, sha in sorted(records[key].attributes.items())},
             # (sorted: a record read back from progress/ has sorted keys, one just rendered has not)
             illuminance_lux={key: dict(sorted((records[key].illuminance_lux or {}).items()))
                              for key in sorted(records) if records[key].kind == PLATE},

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import metricscenes  # noqa: F401  (before numpy: it pins the numeric kernels, as the commands do)
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]

@@ -11,10 +11,12 @@ REPO = Path(__file__).resolve().parents[1]
 # What `benchmark` may import from `metricscenes`: the store API (collections, their
 # ground truth on any grid), value types (manifests, tangent extents, spectral scenes), units
 # (wavelength grid, photometry), small shared helpers (files, CLI, the process-pool and
-# dask backends) and the version. Not the writer: benchmark only reads collections.
+# dask backends, where outputs may go, the one-writer lock its run and sweep folders take),
+# the numeric-kernel pins and their provenance, and the version. Not the writer: benchmark
+# only reads collections.
 PUBLIC = {"metricscenes", "metricscenes.store", "metricscenes.manifest", "metricscenes.geometry", "metricscenes.radiance",
           "metricscenes.spectral", "metricscenes.photometry", "metricscenes.files", "metricscenes.cli_support",
-          "metricscenes.backends"}
+          "metricscenes.backends", "metricscenes.outputs", "metricscenes.lock", "metricscenes.numeric_pins"}
 
 
 def _imports(package: str) -> dict[str, set[str]]:

@@ -359,7 +359,7 @@ def test_run_records_the_hdr_short_exposures(tmp_path):
         def scenes(self):
             return super().scenes()[:2]
 
-        def radiance(self, scene_id, condition):
+        def radiance(self, scene_id, condition, inset_resolution="car"):
             return _lamp_scene(1e-3)
 
     class Detector:

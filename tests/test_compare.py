@@ -116,3 +116,74 @@ def test_cli_runs_and_refuses_in_one_line(tmp_path, run20):
     bad = runner.invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "c"), "--resamples", "10"])
     assert bad.exit_code == 2 and "different collections" in bad.output
     assert "Traceback" not in bad.output
+
+
+def _blind_beyond_25m(gt, *, low_score_hits_at=200.0):
+    """A night pair: both cameras find every car at 25 m (score 0.9) and none farther; B also puts a
+    box of score 0.02 on the car at ``low_score_hits_at`` in 6 of 10 environments (AP > 0 from noise)."""
+    a, b = [], []
+    for im in gt["images"]:
+        box = next(x["bbox"] for x in gt["annotations"] if x["image_id"] == im["id"])
+        if im["distance_m"] == 25.0:
+            hit = {"image_id": im["id"], "category_id": 3, "bbox": list(box), "score": 0.9}
+            a.append(hit)
+            b.append(dict(hit))
+        elif im["distance_m"] == low_score_hits_at and im["environment_id"] < 6:
+            b.append({"image_id": im["id"], "category_id": 3, "bbox": list(box), "score": 0.02})
+    return a, b
+
+
+def test_both_blind_beyond_25m_is_said_plainly_not_called_a_difference():
+    gt, _ = synthetic_collection(10, seed=7)
+    dets_a, dets_b = _blind_beyond_25m(gt)
+    res = compare_runs(side(gt, dets_a, name="camA", condition="night"), side(gt, dets_b, name="camB", condition="night"),
+                       n_resamples=200)
+    far = next(r for r in res["per_distance"] if r["distance_m"] == 200.0)
+    assert far["ap_b"] > 0.1 and far["ci95"][1] < 0  # the interval alone would call B better at 200 m ...
+    assert far["found_b"] == 0 and far["cars_needed"] == 3 and not far["resolved"] and far["blind"]  # ... on noise
+    near = next(r for r in res["per_distance"] if r["distance_m"] == 25.0)
+    assert near["found_a"] == near["found_b"] == 10 and not near["blind"]
+    assert "both blind at night beyond 25 m" in res["verdict"]
+    assert "AP differs at" not in res["verdict"] and "\n" not in res["verdict"]
+
+
+def test_both_blind_everywhere_is_no_difference():
+    gt, _ = synthetic_collection(10, seed=7)
+    noise = [{"image_id": im["id"], "category_id": 3, "bbox": [10.0, 10.0, 30.0, 20.0], "score": 0.05}
+             for im in gt["images"]]
+    res = compare_runs(side(gt, noise, condition="night"), side(gt, noise[:5], name="camB", condition="night"),
+                       n_resamples=50)
+    assert res["verdict"] == ("camA and camB are both blind at night at every measured distance (25 to 200 m: neither "
+                              "camera found 3 of the 10 cars: a car detection of score >= 0.25 on the car at IoU >= 0.5): "
+                              "no difference is called")
+
+
+def test_cli_says_both_blind(tmp_path):
+    from benchmark.cli.main import app
+
+    gt, _ = synthetic_collection(10, seed=7)
+    for name, dets in zip(("a", "b"), _blind_beyond_25m(gt)):
+        folder = tmp_path / name
+        folder.mkdir()
+        results = {"camera": {"name": f"cam-{name}"}, "condition": "night", "collection": {"manifest_sha256": SHA}}
+        (folder / "results.json").write_text(json.dumps(results))
+        (folder / "groundtruth.json").write_text(json.dumps(gt))
+        (folder / "detections.json").write_text(json.dumps(dets))
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    res = CliRunner().invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "100"])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "both blind at night beyond 25 m" in text and "AP differs at" not in text
+    assert "0/10" in text and "10/10" in text and "blind" in text
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before  # no --out: nothing written
+
+
+def test_too_few_cars_to_call_anything_is_said_not_taken_for_blindness():
+    gt, _ = synthetic_collection(2, seed=7)  # two environments: two cars a distance, as on smoke
+    perfect = [{"image_id": a["image_id"], "category_id": 3, "bbox": list(a["bbox"]), "score": 0.9}
+               for a in gt["annotations"]]
+    res = compare_runs(side(gt, perfect), side(gt, perfect[::2], name="camB"), n_resamples=50)
+    assert not any(r["blind"] or r["resolved"] for r in res["per_distance"])
+    assert res["verdict"].endswith("; with 2 cars per distance no difference at a distance can be called "
+                                   "(3 found cars needed)")
+    assert "blind" not in res["verdict"]

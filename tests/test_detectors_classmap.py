@@ -72,7 +72,7 @@ def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
     assert "class_map" not in plain and mapped["class_map"] == ["car"]
     results = {"camera": {"name": "cam01", "spec_sha256": cam.sha256()}, "condition": "day",
                "detector": {"name": "fake", "sha256": "d" * 64, "input_size": "multiscale", "class_map": ["car"]},
-               "collection": {"manifest_sha256": "f" * 64}, "seed": 0}
+               "collection": {"manifest_sha256": "f" * 64}, "seed": 0, "composite": "car"}
     assert results_key(RunResults.model_validate(results)) == mapped != plain
 
 
@@ -115,7 +115,7 @@ def test_run_camera_writes_the_class_map(tmp_path, monkeypatch):
         def scenes(self):
             return super().scenes()[:2]
 
-        def radiance(self, scene_id, condition):
+        def radiance(self, scene_id, condition, inset_resolution="car"):
             return None
 
     monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())

@@ -154,8 +154,8 @@ def test_verify_finds_a_corrupted_chunk(smoke_collection, tmp_path):
 def test_conditions_are_linear_mixes_of_light_groups(smoke_collection):
     c = Collection.open(smoke_collection)
     scene = c.scenes()[0].scene_id
-    day, night = c.radiance(scene, "day"), c.radiance(scene, "night")
-    both = c.radiance(scene, {"sky_day": 1.0, **c.conditions["night"]})
+    day, night = c.radiance(scene, "day"), c.radiance(scene, "night_regulation")
+    both = c.radiance(scene, {"sky_day": 1.0, **c.conditions["night_regulation"]})
     for a, b, ab in zip(day.layers, night.layers, both.layers):
         np.testing.assert_allclose(a.radiance + b.radiance, ab.radiance, rtol=1e-5, atol=1e-12)
     assert len(day.layers) == 2 and day.layers[1].extent.width < day.layers[0].extent.width
@@ -183,7 +183,7 @@ def test_open_refuses_incomplete_folders(tmp_path):
 
 def test_photometry_and_illuminance_sweep(smoke_collection):
     c = Collection.open(smoke_collection)
-    assert c.condition_names == ["day", "night", "day@1lux", "day@100lux"]
+    assert c.condition_names == ["day", "night", "night_regulation", "day@1lux", "day@100lux"]
     scene = c.scenes()[0].scene_id
     day, night = c.photometry(scene, "day"), c.photometry(scene, "night")
     # Daylight is tens of kilolux at the camera; night is below one lux.
@@ -204,7 +204,7 @@ def test_illuminance_sweep_keeps_lamps_on(smoke_collection):
     c = Collection.open(smoke_collection)
     sweep = c.manifest.illuminance_sweep.model_copy(update={"lamps_on": ("car_lights", "ego_lights")})
     c.manifest = c.manifest.model_copy(update={"illuminance_sweep": sweep})
-    weights = c._weights("day@1lux", 0)
+    weights = c._weights("day@1lux", "env000-d025m")
     measured = c.resolved.illuminance_lux["env000"]["sky_day"]
     assert weights == pytest.approx({"sky_day": 1.0 / measured, "car_lights": 1.0, "ego_lights": 1.0})
 

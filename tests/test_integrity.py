@@ -151,7 +151,7 @@ def test_edited_resolved_manifest_is_refused(smoke_collection, tmp_path):
     path.write_text(yaml.safe_dump(resolved, sort_keys=False))
     with pytest.raises(CollectionError, match="content_sha256"):
         Collection.open(root)
-    resolved["manifest"]["conditions"]["night"]["car_lights"] = 2.0
+    resolved["manifest"]["conditions"]["night_regulation"]["car_lights"] = 2.0
     path.write_text(yaml.safe_dump(resolved, sort_keys=False))
     with pytest.raises(CollectionError, match="manifest_sha256"):
         Collection.open(root)
@@ -278,3 +278,182 @@ def test_a_plate_is_mixed_once_for_its_scenes_and_read_again_once_changed(smoke_
     chunk.write_bytes(bytes(data))
     with pytest.raises(CollectionError, match="plates/env001/sky_day does not match its sha256"):
         c.radiance("env001-d050m", "day")  # its file changed: read again, and checked
+
+
+# --- array attributes under the checksum (issue 24, point 2) ------------------------------
+
+def _set_attribute(root: Path, path: str, name: str, change) -> None:
+    """Edit one attribute in an array's zarr.json, as a hand or a tool would."""
+    meta_path = root / "radiance.zarr" / path / "zarr.json"
+    meta = json.loads(meta_path.read_text())
+    meta["attributes"][name] = change(meta["attributes"].get(name))
+    meta_path.write_text(json.dumps(meta, indent=2))
+
+
+def _moved(extent):
+    return [extent[0] + 0.001, extent[1], extent[2] + 0.001, extent[3]]
+
+
+# (array, attribute, change): every kind of attribute a reader takes from an array's zarr.json
+ATTRIBUTE_EDITS = [
+    ("insets/env000-d025m/sky_day", "extent_tan", _moved),  # the car's placement (the issue's case)
+    ("masks/env000-d025m", "extent_tan", _moved),
+    ("frames/env000-d025m/car_lights", "extent_tan", _moved),
+    ("plates/env001/sky_day", "extent_tan", _moved),
+    ("plates/env001/sky_night", "units", lambda _: "W sr-1 m-2 um-1"),
+    ("insets/env000-d025m/sky_night", "wavelengths_nm", lambda w: [v + 5.0 for v in w]),
+    ("insets/env000-d025m/car_lights", "light_group", lambda _: "sky_day"),
+    ("plates/env001/ego_lights", "spp", lambda v: v + 1),
+    # an attribute added: an identity basis decodes to the same values, so only this hash sees it
+    ("insets/env000-d025m/ego_lights", "spectral_basis", lambda _: [[float(i == j) for j in range(31)] for i in range(31)]),
+]
+
+
+def _scene_of(path: str) -> str:
+    unit = path.split("/")[1]
+    return unit if "-" in unit else f"{unit}-d025m"
+
+
+@pytest.mark.parametrize("path, name, change", ATTRIBUTE_EDITS, ids=[f"{p}:{n}" for p, n, _ in ATTRIBUTE_EDITS])
+def test_an_edited_attribute_is_refused_on_read_naming_the_array(smoke_collection, tmp_path, path, name, change):
+    root = _copy(smoke_collection, tmp_path)
+    _set_attribute(root, path, name, change)
+    c = Collection.open(root)  # opening reads no array
+    with pytest.raises(CollectionError) as info:
+        for condition in c.condition_names:
+            c.radiance(_scene_of(path), condition)
+            c.angular_sampling(_scene_of(path))
+    message = str(info.value)
+    assert "\n" not in message and f"{path} attributes do not match their sha256" in message, message
+    assert "rerun `metricscenes generate`" in message
+
+
+def test_verify_lists_edited_attributes_and_generate_repairs_them(smoke_collection, smoke_manifest, tmp_path):
+    from metricscenes.generate import generate
+    from metricscenes.store import verify_collection
+
+    root = _copy(smoke_collection, tmp_path)
+    for path, name, change in ATTRIBUTE_EDITS:
+        _set_attribute(root, path, name, change)
+    problems = verify_collection(root)
+    assert len(problems) == len(ATTRIBUTE_EDITS), problems
+    for path, _, _ in ATTRIBUTE_EDITS:
+        assert any(f"{path} attributes do not match their sha256" in p for p in problems), (path, problems)
+    before = {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()}
+    proc = subprocess.run([sys.executable, "-m", "metricscenes.cli", "verify", str(root)], capture_output=True,
+                          text=True, cwd=REPO, timeout=300)
+    assert proc.returncode == 1 and "Traceback" not in proc.stdout + proc.stderr
+    assert len([line for line in proc.stdout.splitlines() if line.startswith("bad: ")]) == len(ATTRIBUTE_EDITS)
+    assert [line for line in proc.stderr.splitlines() if line.strip()] == [
+        f"error: {root}: {len(ATTRIBUTE_EDITS)} problem(s); rerun `metricscenes generate` with its manifest to repair it"]
+    assert {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()} == before
+    notices = []
+    generate(smoke_manifest, root, notice=notices.append)
+    assert {line.split()[1] for line in notices} == {"env000-d025m", "env001"}, notices  # the two units, rendered again
+    assert verify_collection(root) == []
+    for path, _, _ in ATTRIBUTE_EDITS:
+        meta = "radiance.zarr/" + path + "/zarr.json"
+        assert (root / meta).read_bytes() == (smoke_collection / meta).read_bytes(), path
+    for name in ("manifest.resolved.yaml", "groundtruth.json"):
+        assert (root / name).read_bytes() == (smoke_collection / name).read_bytes(), name
+
+
+def test_benchmark_run_refuses_a_moved_car_in_one_line_and_writes_nothing(smoke_collection, tmp_path):
+    """The issue's case: the car's placement moved in the insets' zarr.json. `benchmark run`
+    exited 0 with AP 0.000 at every distance; now it stops at the first such scene."""
+    root = _copy(smoke_collection, tmp_path)
+    for scene in ("env000-d025m", "env001-d100m"):
+        for group in ("sky_day", "sky_night", "car_lights", "ego_lights"):
+            _set_attribute(root, f"insets/{scene}/{group}", "extent_tan", _moved)
+    before = {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()}
+    out = tmp_path / "run"
+    proc = subprocess.run([sys.executable, "-m", "benchmark.cli.main", "run", "--camera", "cam12", "--collection",
+                           str(root), "--out", str(out)], capture_output=True, text=True, cwd=REPO, timeout=300)
+    assert proc.returncode == 2 and "Traceback" not in proc.stdout + proc.stderr
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "scene env000-d025m: insets/env000-d025m/" in lines[0], proc.stderr
+    assert "attributes do not match their sha256" in lines[0]
+    assert not out.exists()
+    assert {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()} == before
+
+
+def _as_written_before_attribute_hashes(root: Path) -> None:
+    """Make a copy look like a collection written before attributes had a sha256: no
+    attributes in its records, none in its resolved manifest (whose content hash is redone)."""
+    from metricscenes.records import resolved_content_sha256
+
+    for record_path in (root / "progress").glob("*.json"):
+        record = json.loads(record_path.read_text())
+        del record["attributes"]
+        record_path.write_text(json.dumps(record, indent=1, sort_keys=True))
+    path = root / "manifest.resolved.yaml"
+    resolved = yaml.safe_load(path.read_text())
+    del resolved["attributes_sha256"]
+    resolved["content_sha256"] = resolved_content_sha256(resolved)
+    path.write_text(yaml.safe_dump(resolved, sort_keys=False))
+
+
+def test_an_older_collection_verifies_and_generate_records_its_attributes_without_rendering(
+        smoke_collection, smoke_manifest, tmp_path):
+    from metricscenes.generate import generate
+
+    root = _copy(smoke_collection, tmp_path)
+    _as_written_before_attribute_hashes(root)
+    assert Collection.open(root).verify() == []
+    _read_scene(root, "env000-d025m")  # read as before: unchecked attributes
+    proc = subprocess.run([sys.executable, "-m", "metricscenes.cli", "verify", str(root)], capture_output=True,
+                          text=True, cwd=REPO, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    notes = [line for line in proc.stdout.splitlines() if line.startswith("note: ")]
+    assert len(notes) == 1 and "rerun `metricscenes generate` with its manifest to record them" in notes[0], proc.stdout
+    rendered = []
+    generate(smoke_manifest, root, notice=rendered.append,
+             progress=lambda d, t, k: rendered.append(k) if k else None)
+    assert rendered == []  # metadata only
+    for path in [*(root / "progress").glob("*.json"), root / "manifest.resolved.yaml", root / "groundtruth.json"]:
+        rel = path.relative_to(root)
+        assert path.read_bytes() == (smoke_collection / rel).read_bytes(), rel
+    proc = subprocess.run([sys.executable, "-m", "metricscenes.cli", "verify", str(root)], capture_output=True,
+                          text=True, cwd=REPO, timeout=300)
+    assert proc.returncode == 0 and "note:" not in proc.stdout
+
+
+def test_an_older_collection_with_a_moved_car_is_rendered_again_not_blessed(smoke_collection, smoke_manifest, tmp_path):
+    from metricscenes.generate import generate
+
+    root = _copy(smoke_collection, tmp_path)
+    _as_written_before_attribute_hashes(root)
+    _set_attribute(root, "insets/env001-d100m/car_lights", "extent_tan", _moved)
+    notices = []
+    generate(smoke_manifest, root, notice=notices.append)
+    assert notices == ["rendering env001-d100m again: env001-d100m: insets/env001-d100m/car_lights attribute "
+                       "'extent_tan' is not the one written"]
+    assert (root / "manifest.resolved.yaml").read_bytes() == (smoke_collection / "manifest.resolved.yaml").read_bytes()
+    assert Collection.open(root).verify() == []
+
+
+def test_attributes_of_every_store_setting_are_hashed_as_read_back(tmp_path):
+    """The writer's attribute hashes are those of the zarr.json a reader sees, with a
+    spectral basis and rounded mantissas too; an edited basis or rounding width is refused."""
+    import numpy as np
+    import zarr
+
+    from metricscenes.geometry import REFERENCE_EXTENT
+    from metricscenes.store import RADIANCE_STORE, attributes_sha256, read_checked
+    from metricscenes.writer import UnitArrays
+
+    cube = np.random.default_rng(0).random((9, 16, 31), dtype=np.float32)
+    arrays = UnitArrays(tmp_path, "env000", mantissa_bits=8, spectral_basis=6)
+    arrays.write_radiance("plates", "sky_day", cube, REFERENCE_EXTENT, {"spp": 4, "seed": 1})
+    path = "plates/env000/sky_day"
+    group = zarr.open_group(str(tmp_path / RADIANCE_STORE), mode="r")
+    assert arrays.attributes_sha256[path] == attributes_sha256(dict(group[path].attrs))
+    read_checked(tmp_path, group, path, arrays.sha256[path], "environment env000", arrays.attributes_sha256[path])
+    for name, change in (("spectral_basis", lambda b: [[v * 1.0000001 for v in row] for row in b]),
+                         ("mantissa_bits", lambda v: v + 1)):
+        _set_attribute(tmp_path, path, name, change)
+        group = zarr.open_group(str(tmp_path / RADIANCE_STORE), mode="r")
+        with pytest.raises(CollectionError, match=f"{path} attributes do not match their sha256"):
+            read_checked(tmp_path, group, path, arrays.sha256[path], "environment env000",
+                         arrays.attributes_sha256[path])
+        arrays.write_radiance("plates", "sky_day", cube, REFERENCE_EXTENT, {"spp": 4, "seed": 1})  # as it was

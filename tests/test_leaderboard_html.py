@@ -24,10 +24,11 @@ SYSTEMS = (("cam03", 150.0), ("cam12", 100.0), ("cam01", 55.0))
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (Debian: apt-get install -y chromium)")
 
 
-def _browse(url: str, profile: Path) -> tuple[str, list[str]]:
+def _browse(url: str, profile: Path, *flags: str) -> tuple[str, list[str]]:
     """(DOM after scripts ran, console messages) of ``url`` in headless Chromium."""
     profile.mkdir(parents=True, exist_ok=True)
-    proc = subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", url], capture_output=True, text=True, timeout=120)
+    proc = subprocess.run([CHROMIUM, *FLAGS, *flags, f"--user-data-dir={profile}", url], capture_output=True, text=True,
+                          timeout=120)
     console = [line for line in proc.stderr.splitlines() if ":CONSOLE" in line]
     return proc.stdout, console
 
@@ -107,3 +108,29 @@ def test_sorting_by_column(chromium_works, page, tmp_path, fragment, expected):
     key = fragment.removeprefix("sort=").lstrip("-")
     direction = "descending" if fragment.startswith("sort=-") else "ascending"
     assert re.search(rf'<th data-key="{key}" data-type="\w+" aria-sort="{direction}">', dom)
+
+
+# Writes the page's widths into the DOM once laid out (run on a copy without the CSP, which allows the page's own script only).
+MEASURE = ("<script>window.addEventListener('load', () => { const d = document.documentElement; "
+           "const boxes = [...document.querySelectorAll('.scroll')].map(e => [e.scrollWidth, e.clientWidth]); "
+           "const p = document.createElement('pre'); p.id = 'widths'; "
+           "p.textContent = JSON.stringify({page: [d.scrollWidth, d.clientWidth], tables: boxes}); "
+           "document.body.appendChild(p); });</script>")
+
+
+def test_committed_table_fits_1400_px_without_scrolling_sideways(chromium_works, tmp_path):
+    """The committed leaderboard (15 columns: three conditions, MTF50 in both units, focal length,
+    field of view) fits a 1400 px wide window: neither the page nor a table scrolls sideways."""
+    import json
+
+    text = (REPO / "leaderboard" / "index.html").read_text(encoding="utf-8")
+    text = re.sub(r'<meta http-equiv="Content-Security-Policy"[^>]*>', "", text).replace("</body>", MEASURE + "</body>")
+    copy = tmp_path / "index.html"
+    copy.write_text(text, encoding="utf-8")
+    dom, _ = _browse(copy.as_uri(), tmp_path / "profile", "--window-size=1400,900")
+    found = re.search(r'<pre id="widths">([^<]*)</pre>', dom)
+    assert found, dom[-500:]
+    widths = json.loads(found.group(1))
+    assert widths["page"][0] <= widths["page"][1], widths
+    assert widths["tables"] and all(scroll <= client for scroll, client in widths["tables"]), widths
+    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text

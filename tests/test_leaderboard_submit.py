@@ -295,12 +295,16 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     assert day["per_distance"] == [r.model_dump() for r in results.per_distance]
     assert day["od50_m"] == results.od50_m  # both None (inf) or the same metres
     expected = "∞" if day["od50_m"] is None else f"{day['od50_m']:.1f}"
-    row = next(line for line in (lb / "README.md").read_text().splitlines() if "cam01-yolov5n-smoke" in line)
-    cells = [c.strip() for c in row.strip("|").split("|")]
-    assert cells[0] == "1" and cells[2] == "cam01" and cells[3].split(" ±")[0] == expected
+    lines = (lb / "README.md").read_text().splitlines()
+    row = next(line for line in lines if "cam01-yolov5n-smoke" in line)
+    header = next(line for line in lines if line.startswith("| # |"))
+    cells = dict(zip([c.strip() for c in header.strip("|").split("|")], [c.strip() for c in row.strip("|").split("|")]))
+    assert cells["#"] == "1" and cells["Camera"] == "cam01" and cells["Day OD50 (m)"].split(" ±")[0] == expected
     html = (lb / "index.html").read_text()
     assert 'href="submissions/cam01-yolov5n-smoke.json"' in html and f">{expected}" in html
-    assert math.isclose(float(cells[6]), 4.2) and math.isclose(float(cells[7]), 3.1)  # pixel pitch, f-number
+    assert math.isclose(float(cells["Pixel (µm)"]), 4.2) and math.isclose(float(cells["f-number"]), 3.1)
+    assert cells["Focal (mm)"] == "4.38" and cells["FOV (°)"] == "34.1 × 19.6"
+    assert math.isclose(float(cells["MTF50 (cy/mrad)"]), float(cells["MTF50 (cy/mm)"]) * 4.38 / 1000, abs_tol=0.01)
 
 
 def test_committed_reference_submissions_are_valid_and_rendered():

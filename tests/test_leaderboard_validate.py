@@ -160,6 +160,16 @@ def _ci_lo_infinite(sub):
     sub["conditions"]["day"]["od50_ci95_m"] = [None, _day_od50(sub) + 5.0]
 
 
+def _ci_excludes(sub):
+    od = _day_od50(sub)
+    sub["conditions"]["day"]["od50_ci95_m"] = [od + 5.0, od + 10.0]
+
+
+def _sd_zero(sub):
+    od = _day_od50(sub)
+    sub["conditions"]["day"].update(od50_sd_m=0.0, od50_ci95_m=[od - 5.0, od + 5.0])
+
+
 def _same_detections(sub):
     sub["conditions"]["night"]["detections_sha256"] = sub["conditions"]["day"]["detections_sha256"]
 
@@ -231,6 +241,38 @@ BAD = [
     ("same-detections", _edit(_same_detections), "good.json", "conditions.day and conditions.night have the same detections_sha256"),
     ("created-in-the-future", _edit(lambda s: s.update(created_at="9999-12-31T23:59:59Z")), "good.json",
      "created_at 9999-12-31T23:59:59Z is in the future"),
+    # issue 24, point 4: inconsistent fields that passed --check
+    ("n-images-not-one-per-environment", _edit(lambda s: s["conditions"]["day"]["per_distance"][0].update(n_images=99)),
+     "good.json", "conditions.day.per_distance: n_images 99 at 25 m, but a collection of 4 environments has 4 images at each distance"),
+    ("interval-excludes-od50", _edit(_ci_excludes), "good.json", "conditions.day.od50_m = "),
+    ("sd-zero-with-a-wide-interval", _edit(_sd_zero), "good.json", "conditions.day.od50_sd_m = 0, but its od50_ci95_m"),
+    ("detector-sha-not-the-models", _edit(lambda s: s["detector"].update(sha256="ab" * 32)), "good.json",
+     "detector.sha256 abababababab... is not the sha256 of registry model 'yolov5n-dynamic'"),
+    ("registry-model-under-another-name", _edit(lambda s: s["detector"].update(name="my-own-net")), "good.json",
+     "is registry model 'yolov5n-dynamic', but detector.name is 'my-own-net'"),
+    ("licence-not-the-models", _edit(lambda s: s["detector"].update(licence="MIT")), "good.json",
+     "detector.licence 'MIT' is not registry model 'yolov5n-dynamic''s ('AGPL-3.0')"),
+    ("family-not-the-models", _edit(lambda s: s["detector"].update(family="yolov8")), "good.json",
+     "detector.family 'yolov8' is not registry model 'yolov5n-dynamic''s"),
+    ("unknown-family", _edit(lambda s: s["detector"].update(name="my-own-net", sha256="ab" * 32, family="rcnn")),
+     "good.json", "detector.family 'rcnn' is not a known family"),
+    ("input-size-not-a-policy", _edit(lambda s: s["detector"].update(input_size=33)), "good.json",
+     "detector.input_size must be 'native', 'multiscale' or a positive multiple of 32, got 33"),
+    ("score-threshold-not-aps", _edit(lambda s: s["detector"].update(score_threshold=0.5)), "good.json",
+     "detector.score_threshold 0.5 is not AP's 0.001"),
+    ("single-label", _edit(lambda s: s["detector"].update(multi_label=False)), "good.json", "detector.multi_label is false"),
+    ("rtl-override-in-a-name", _edit(lambda s: s.update(submitter="ref\u202emetricscenes")), "good.json",
+     "submitter: string holds an invisible formatting character U+202E (right-to-left override)"),
+    ("zero-width-space-in-notes", _edit(lambda s: s.update(notes="cam\u200b12")), "good.json",
+     "notes: string holds an invisible formatting character U+200B (zero width space)"),
+    ("blank-submitter", _edit(lambda s: s.update(submitter=" ")), "good.json", "submitter ' ' is blank or padded"),
+    ("padded-detector-name", _edit(lambda s: s["detector"].update(name="yolov5n-dynamic ")), "good.json",
+     "detector.name 'yolov5n-dynamic ' is blank or padded"),
+    ("measured-mtf50-not-the-cameras", _edit(lambda s: s["camera"].update(mtf50_source="measured", mtf50_cy_per_mm=999.9)),
+     "good.json", "camera.mtf50_cy_per_mm 999.9 (measured) is not the camera's: its spec gives"),
+    ("no-mtf50-for-a-spec-with-a-group", _edit(lambda s: s["camera"].update(mtf50_source="none", mtf50_cy_per_mm=None)),
+     "good.json", "camera.mtf50_source is 'none', but the spec has a published MTF50 group"),
+    ("detections-of-another-entry", lambda good: b"", "good.json", "is the detections of existing.json"),  # made in the test
 ]  # fmt: skip
 
 
@@ -242,8 +284,11 @@ def _invoke(app, args):
 
 @pytest.mark.parametrize("case", BAD, ids=[c[0] for c in BAD])
 def test_bad_submission_refused(app, world, tmp_path, case):
-    _, make, file_name, expected = case
+    case_id, make, file_name, expected = case
     path = tmp_path / file_name
+    if case_id == "detections-of-another-entry":  # copied detections: another entry's day run
+        make = _edit(lambda s: s["conditions"]["day"].update(
+            detections_sha256=world["existing"]["conditions"]["day"]["detections_sha256"]))
     path.write_bytes(make(world["good"]))
     before = tree_sha256(world["leaderboard"])
     res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
@@ -280,7 +325,35 @@ def test_content_duplicate_under_another_name(app, world, tmp_path):
     path = tmp_path / "renamed.json"
     path.write_text(dumps_submission(sub))
     res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
-    assert res.exit_code == 2 and "duplicate: existing.json has the same camera, detector, collection and detections" in stderr
+    assert res.exit_code == 2 and "duplicate: existing.json already ranks the same camera spec, detector and collection" in stderr
+
+
+def test_a_reproduction_of_an_entry_is_not_a_second_row(app, world, tmp_path):
+    """The same camera spec, detector and collection run again (other detections: another
+    seed or machine) under another name: refused as a duplicate, by `submit --check` and by
+    `benchmark leaderboard` when such a file is dropped in by hand."""
+    import shutil
+
+    sub = copy.deepcopy(world["existing"])
+    sub["name"] = "existing-again"
+    for cond in sub["conditions"].values():
+        cond["detections_sha256"] = hashlib.sha256(cond["detections_sha256"].encode()).hexdigest()
+    path = tmp_path / "existing-again.json"
+    path.write_text(dumps_submission(sub))
+    before = tree_sha256(world["leaderboard"])
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
+    assert res.exit_code == 2 and stderr.strip().splitlines() == [
+        "error: duplicate: existing.json already ranks the same camera spec, detector and collection (a reproduction "
+        "of it is not a second row; to replace it, remove existing.json first)"], stderr
+    assert tree_sha256(world["leaderboard"]) == before
+    lb = tmp_path / "lb"
+    shutil.copytree(world["leaderboard"], lb)
+    shutil.copy(path, lb / "submissions" / path.name)
+    before = tree_sha256(lb)
+    res, stderr = _invoke(app, ["leaderboard", "--dir", lb])
+    assert res.exit_code == 2 and len(stderr.strip().splitlines()) == 1, stderr
+    assert "submissions/existing.json: duplicate: existing-again.json already ranks the same camera spec" in stderr
+    assert tree_sha256(lb) == before
 
 
 @pytest.mark.parametrize("what", ["ap", "ap50"])

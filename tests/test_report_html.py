@@ -68,7 +68,8 @@ def test_sweep_report_table_matches_od50_csv(sweep_dir, page):
     od50 = pd.read_csv(sweep_dir / "od50.csv")
     assert len(od50) == 8
     table = _html_table(page.split("<h2>Results</h2>", 1)[1])
-    assert len(table) == 8 and list(table.columns[:5]) == ["camera", "condition", "MTF50 (cy/mm)", "OD50 ± SD (m)", "95 % interval (m)"]
+    assert len(table) == 8 and list(table.columns[:8]) == ["camera", "condition", "MTF50 (cy/mm)", "MTF50 (cy/mrad)",
+                                                           "focal length (mm)", "FOV (°)", "OD50 ± SD (m)", "95 % interval (m)"]
     for _, row in od50.iterrows():
         shown = table[(table.camera == row.camera) & (table.condition == row.condition)].iloc[0]
         assert shown["OD50 ± SD (m)"] == f"{row.od50_m:.1f} ± {row.sd_m:.1f}" or not np.isfinite(row.od50_m)

@@ -17,9 +17,9 @@ from conftest import REPO, SMOKE_MANIFEST
 
 # The published manifests' sha256: collections and leaderboard entries are keyed by them.
 PUBLISHED_SHA256 = {
-    "smoke": "a8ca4cecf92284ca884223b2777fe51db0c2849219f857491eed583d165a5507",
-    "quick": "1c59afba899cb2012e2d0a3f2222a7947ecfb7b49706b9fd6e8584d528fb771b",
-    "metric-300": "e05e9808c4f01ecd615c39db393360a42c21def637e9974b25435f3959382d26",
+    "smoke": "2b496a1a26819de6db01186453bfb52231475da05b2c558a5d153342fd8ee687",
+    "quick": "6ce3394e3129c2704092906ed6ae4d447610c48f19399a571be4319123edaf00",
+    "metric-300": "fd9342ff7e065f1d172afca80942cb14e08ddd056981ee56f914a44a77d14db5",
 }
 
 

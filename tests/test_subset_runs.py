@@ -57,7 +57,7 @@ def test_run_camera_records_the_subset(tmp_path, monkeypatch):
             return [[] for _ in images]
 
     class Collection(FakeCollection):
-        def radiance(self, scene_id, condition):
+        def radiance(self, scene_id, condition, inset_resolution="car"):
             return None
 
     monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
@@ -126,7 +126,7 @@ def test_subset_cache_key(tmp_path):
                                                               "distances_m": sorted({s.distance_m for s in col.scenes()})}
     results = {"camera": {"name": "cam01", "spec_sha256": cam.sha256()}, "condition": "day",
                "detector": {"name": "fake", "sha256": "d" * 64, "input_size": "multiscale"},
-               "collection": {"manifest_sha256": "f" * 64}, "seed": 0, "subset": sub_key["subset"]}
+               "collection": {"manifest_sha256": "f" * 64}, "seed": 0, "subset": sub_key["subset"], "composite": "car"}
     assert results_key(RunResults.model_validate(results)) == sub_key != full_key
 
 

@@ -47,6 +47,9 @@ class FakeCollection:
     def groundtruth(self):
         return json.loads(json.dumps(self._gt))
 
+    def condition_record(self, scene_id, condition):  # fixed-weight conditions only
+        return None
+
 
 @dataclass
 class FakeDetector:

@@ -1,7 +1,8 @@
-"""What a camera spec implies: field of view, IFOV, Nyquist, saturation, dynamic range,
-SNR at a stated reference, and warnings where the spec hides something (a well the gain
-makes unreachable). ``benchmark cameras show`` prints them (docs/camera.md, "Field of
-view and geometry", "What a spec implies").
+"""What a camera spec implies: field of view, IFOV, Nyquist and MTF50 (cycles/mm on the
+sensor and cycles/mrad in object space), saturation, dynamic range, SNR at a stated
+reference, and warnings where the spec hides something (a well the gain makes
+unreachable, a value outside what most sensors have). ``benchmark cameras show`` prints
+them (docs/camera.md, "Field of view and geometry", "What a spec implies").
 
 Every figure is computed from the spec with the pipeline's own formulas: saturation by
 :func:`benchmark.camera.sensor.saturation_electrons`, the reference signal by
@@ -12,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from benchmark.camera.spec import MAX_CAPTURE_GIB, CameraSpec
+from benchmark.camera.spec import MAX_CAPTURE_GIB, CameraSpec, plausibility_warnings
 
 REFERENCE_ILLUMINANCE_LUX = 100.0
 """Illuminance of the SNR reference: a 18 % grey Lambertian surface lit by 100 lux of D65."""
@@ -49,8 +50,10 @@ def reference_signal_e_per_s(camera: CameraSpec) -> float:
 def camera_figures(camera: CameraSpec) -> dict:
     """What the spec implies, as a JSON-ready dict (units in the keys)."""
     from benchmark.camera.sensor import saturation_electrons, signal_volts_per_electron
+    from benchmark.measure.mtf import camera_mtf50
 
     s = camera.sensor
+    mtf50, mtf50_source = camera_mtf50(camera)
     volts_per_e = signal_volts_per_electron(s)
     adc_e = (s.white_level_dn - s.black_level_dn) * s.lsb_v / volts_per_e
     saturation = saturation_electrons(s)
@@ -72,6 +75,10 @@ def camera_figures(camera: CameraSpec) -> dict:
         "ifov_mrad": round(camera.ifov_mrad, 6),
         "distortion_k1_k2": list(camera.optics.distortion) if camera.optics.distortion else None,
         "nyquist_cy_per_mm": round(camera.nyquist_cy_per_mm, 4),
+        "nyquist_cy_per_mrad": round(camera.cy_per_mrad(camera.nyquist_cy_per_mm), 4),
+        "mtf50": {"cy_per_mm": None if mtf50 is None else round(mtf50, 2),
+                  "cy_per_mrad": None if mtf50 is None else round(camera.cy_per_mrad(mtf50), 4),
+                  "source": mtf50_source},
         "saturation_e": round(saturation, 1),
         "saturation_limited_by": "adc" if adc_e < s.well_capacity_e else "well",
         "well_capacity_e": s.well_capacity_e,
@@ -123,7 +130,7 @@ def camera_warnings(camera: CameraSpec, figures: dict | None = None) -> list[str
         out.append("the SNR reference saturates at the reference exposure (the figure is at saturation)")
     if f["capture_memory_gib"] > MAX_CAPTURE_GIB / 2:
         out.append(f"one capture needs about {f['capture_memory_gib']:.1f} GiB")
-    return out
+    return out + plausibility_warnings(camera)
 
 
 def figure_rows(figures: dict) -> list[tuple[str, str]]:
@@ -139,7 +146,9 @@ def figure_rows(figures: dict) -> list[tuple[str, str]]:
                           + (", distortion k1 {:g}, k2 {:g}".format(*figures["distortion_k1_k2"])
                              if figures["distortion_k1_k2"] else "") + ")"),
         ("IFOV", f"{figures['ifov_mrad']:.4g} mrad per pixel (on the axis)"),
-        ("Nyquist", f"{figures['nyquist_cy_per_mm']:.1f} cy/mm"),
+        ("Nyquist", f"{figures['nyquist_cy_per_mm']:.1f} cy/mm on the sensor, "
+                    f"{figures['nyquist_cy_per_mrad']:.3f} cy/mrad in object space"),
+        ("MTF50", _mtf50_text(figures["mtf50"], figures["focal_length_mm"])),
         ("saturation", f"{figures['saturation_e']:.0f} e- ({figures['saturation_limited_by']}; well "
                        f"{figures['well_capacity_e']:.0f} e-, ADC {figures['adc_saturation_e']:.0f} e-)"),
         ("dynamic range", (f"{dr:.1f} dB" if dr is not None else "inf") +
@@ -147,3 +156,11 @@ def figure_rows(figures: dict) -> list[tuple[str, str]]:
         ("SNR reference", snr_text),
         ("memory per capture", f"about {figures['capture_memory_gib']:.2f} GiB"),
     ]
+
+
+def _mtf50_text(mtf50: dict, focal_length_mm: float) -> str:
+    """"229.3 cy/mm on the sensor, 1.004 cy/mrad in object space (× f 4.38 mm; measured)"."""
+    if mtf50["cy_per_mm"] is None:
+        return "- (no source gave one)"
+    return (f"{mtf50['cy_per_mm']:.1f} cy/mm on the sensor, {mtf50['cy_per_mrad']:.3f} cy/mrad in object space "
+            f"(x f {focal_length_mm:g} mm / 1000; {mtf50['source']})")

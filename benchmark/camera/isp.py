@@ -12,6 +12,9 @@ it never reads spectra itself.
 
 from __future__ import annotations
 
+import functools
+from importlib import resources
+
 import colour
 import colour_demosaicing
 import numpy as np
@@ -60,11 +63,47 @@ def demosaic(mosaic: np.ndarray, method: str = "malvar2004", cfa: str = "RGGB") 
     return np.asarray(rgb, dtype=np.float32)
 
 
+_BUCKET_SHIFT = 12  # float32 bit patterns >> 12: never two decision levels in one bucket (checked below)
+
+
+@functools.lru_cache(maxsize=1)
+def srgb8_thresholds() -> np.ndarray:
+    """(255,) float32: the smallest linear value that encodes to each 8-bit code 1..255
+    (package data ``data/srgb8_thresholds.csv``)."""
+    text = resources.files("benchmark.camera").joinpath("data/srgb8_thresholds.csv").read_text()
+    rows = [line.split(",") for line in text.splitlines() if line and line[0].isdigit()]
+    return np.array([float.fromhex(value) for _, value in rows], dtype=np.float32)
+
+
+@functools.lru_cache(maxsize=1)
+def _srgb8_buckets() -> tuple[np.ndarray, np.ndarray]:
+    """Per bucket of float32 bit patterns in [0, 1]: the code at its start and the next
+    decision level (a table lookup and one comparison instead of a binary search)."""
+    levels = srgb8_thresholds()
+    top = int(np.float32(1.0).view(np.uint32)) >> _BUCKET_SHIFT
+    starts = (np.arange(top + 1, dtype=np.uint32) << _BUCKET_SHIFT).view(np.float32)
+    base = np.searchsorted(levels, starts, side="right")
+    bucket_of_level = levels.view(np.uint32) >> _BUCKET_SHIFT
+    if np.any(np.diff(bucket_of_level) == 0):
+        raise AssertionError("two sRGB decision levels share a bucket: lower _BUCKET_SHIFT")
+    following = np.append(levels, np.float32(np.inf))[base]
+    return base.astype(np.uint8), following
+
+
 def encode_srgb8(rgb_linear: np.ndarray) -> np.ndarray:
-    """Linear sRGB (clipped to [0, 1]) → 8-bit sRGB (IEC 61966-2-1 transfer curve)."""
-    x = np.clip(rgb_linear, 0.0, 1.0).astype(np.float32)
-    v = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4, dtype=np.float32) - 0.055)
-    return np.rint(v * 255.0).astype(np.uint8)
+    """Linear sRGB (clipped to [0, 1]) → 8-bit sRGB (IEC 61966-2-1 transfer curve).
+
+    The curve is applied as a search among its 255 decision levels, not through
+    ``np.power``: numpy's SIMD ``power`` differs in the last bit between instruction sets
+    (AVX-512 machines take other kernels), which moved a code by one here and there. The
+    levels are those of the float32 formula, so the codes equal it wherever it agrees with
+    itself (docs/performance.md, "Bytes across machines").
+    """
+    # fmax/fmin: NaN → 0 (black); adding +0.0 turns -0.0 into +0.0 (bit patterns index the table)
+    x = np.fmin(np.fmax(np.asarray(rgb_linear, dtype=np.float32), np.float32(0.0)), np.float32(1.0)) + np.float32(0.0)
+    base, following = _srgb8_buckets()
+    bucket = x.view(np.uint32) >> _BUCKET_SHIFT
+    return base[bucket] + (x >= following[bucket])
 
 
 def process(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec, calibration: Calibration) -> np.ndarray:

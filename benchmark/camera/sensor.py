@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.camera.spec import SensorSpec
+from benchmark.camera.spec import SensorSpec, check_qe_table
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j, resample_spectrum
 
 CHANNELS = ("r", "g", "b")
@@ -45,15 +45,12 @@ class NoiseOptions:
 
 @functools.lru_cache(maxsize=16)
 def _read_qe_table(path: str) -> tuple[np.ndarray, np.ndarray]:
-    table = np.genfromtxt(path, delimiter=",", names=True)
-    names = table.dtype.names
-    missing = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b") if c not in names]
-    if missing:
-        raise ValueError(f"{path}: QE table lacks column(s) {', '.join(missing)}")
-    qe = np.stack([table[f"qe_{c}"] for c in CHANNELS])
-    if "ir_cut_transmittance" in names:
-        qe = qe * table["ir_cut_transmittance"][None, :]
-    return np.asarray(table["wavelength_nm"], float), qe
+    """(wavelengths nm, QE × IR-cut (3, n)) of a QE file, refused in one line unless it is
+    physically possible (:func:`benchmark.camera.spec.check_qe_table`)."""
+    wl, qe, ir_cut = check_qe_table(path)
+    if ir_cut is not None:
+        qe = qe * ir_cut[None, :]
+    return wl, qe
 
 
 def effective_qe(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:

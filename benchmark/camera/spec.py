@@ -13,9 +13,11 @@ is rounded to whole pixels, and the field of view is the pixel array's,
 are square in angle by construction (docs/camera.md, "Field of view and geometry").
 
 A spec is validated as a whole (docs/camera.md, "Refused specs"): black level below the
-ADC white level, a ``qe`` file that is packaged or lies beside the spec file, a known
-illuminant, a pixel array of at least 16 × 16 and at most :data:`MAX_CAPTURE_GIB` of
-memory for one capture.
+ADC white level, a ``qe`` file that is packaged or lies beside the spec file and holds a
+physically possible table (:func:`check_qe_table`), a known illuminant, a pixel array of
+at least 16 × 16 and at most :data:`MAX_CAPTURE_GIB` of memory for one capture. Values
+no sensor has are refused with the unit mistake they most likely are, and unusual but
+possible ones are warned about (:data:`PLAUSIBLE`, docs/camera.md, "Plausible values").
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Literal
 
@@ -86,6 +89,142 @@ def _check_qe_syntax(value: str) -> str:
     if PurePosixPath(value).suffix.lower() != ".csv":
         raise ValueError("a .csv file is expected (columns wavelength_nm, qe_r, qe_g, qe_b)")
     return value
+
+
+@dataclass(frozen=True)
+class Plausible:
+    """Where one spec field's values lie on real sensors (docs/camera.md, "Plausible values").
+
+    A value outside ``refused`` is no sensor's: it is refused with the unit mistake it most
+    likely is (the first of ``mistakes``, ``(unit, factor to this field's unit)``, that
+    brings it inside). A value outside ``usual`` but inside ``refused`` is possible, and
+    ``benchmark cameras show`` warns about it."""
+
+    what: str
+    unit: str
+    refused: tuple[float, float]
+    usual: tuple[float, float]
+    mistakes_below: tuple[tuple[str, float], ...] = ()
+    mistakes_above: tuple[tuple[str, float], ...] = ()
+
+
+PLAUSIBLE: dict[str, Plausible] = {
+    "exposure.max_exposure_s": Plausible("an exposure cap", "s", (1e-7, 1.0), (1e-4, 0.1),
+                                         mistakes_above=(("ms", 1e-3), ("us", 1e-6))),
+    "exposure.exposure_s": Plausible("an exposure time", "s", (1e-7, 1.0), (1e-5, 0.1),
+                                     mistakes_above=(("ms", 1e-3), ("us", 1e-6))),
+    "sensor.conversion_gain_uv_per_e": Plausible("a conversion gain", "uV/e-", (1.0, 1000.0), (10.0, 300.0),
+                                                 mistakes_below=(("V/e-", 1e6), ("mV/e-", 1e3)),
+                                                 mistakes_above=(("nV/e-", 1e-3),)),
+    "sensor.well_capacity_e": Plausible("a full well", "e-", (300.0, 1e7), (2000.0, 1e6),
+                                        mistakes_below=(("ke-", 1e3),)),
+    "sensor.voltage_swing_v": Plausible("a pixel voltage swing", "V", (0.05, 5.0), (0.2, 3.3),
+                                        mistakes_above=(("mV", 1e-3),)),
+    "sensor.read_noise_e": Plausible("a read noise", "e-", (0.0, 1000.0), (0.0, 50.0)),
+    "sensor.dark_current_e_per_s": Plausible("a dark current", "e-/s", (0.0, 1e6), (0.0, 1000.0)),
+    "sensor.dsnu_v": Plausible("a DSNU", "V", (0.0, 0.1), (0.0, 0.01), mistakes_above=(("mV", 1e-3),)),
+    "sensor.prnu_fraction": Plausible("a PRNU", "(fraction)", (0.0, 0.1), (0.0, 0.03),
+                                      mistakes_above=(("percent", 1e-2),)),
+}
+"""Plausible ranges of the spec fields whose unit is easy to get wrong (sources in docs/camera.md)."""
+
+
+def _unit(unit: str) -> str:
+    return "" if unit.startswith("(") else f" {unit}"
+
+
+def _number(value: float) -> str:
+    """``10000000``, ``0.03``, ``1e-06``: as short as exact, without ``1e+07``."""
+    return f"{value:.0f}" if abs(value) >= 1e5 and float(value).is_integer() else f"{value:.6g}"
+
+
+def check_plausible(field: str, value):
+    """``value`` of ``field`` (``"sensor.well_capacity_e"``) if a sensor can have it; else a
+    one-line ValueError with the plausible range and the likely unit mistake. Not a number:
+    returned as it is, for pydantic's own check."""
+    rule = PLAUSIBLE[field]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return value
+    lo, hi = rule.refused
+    if lo <= value <= hi:
+        return value
+    mistakes = rule.mistakes_below if value < lo else rule.mistakes_above
+    hint = next((f"; if it was meant in {unit}, write {_number(value * factor)}" for unit, factor in mistakes
+                 if lo <= value * factor <= hi), "")
+    side = "below" if value < lo else "above"
+    raise ValueError(f"{rule.what} of {_number(value)}{_unit(rule.unit)} is {side} the plausible range "
+                     f"{_number(lo)} to {_number(hi)}{_unit(rule.unit)} of real sensors{hint} "
+                     "(docs/camera.md, \"Plausible values\")")
+
+
+def plausibility_warnings(camera: "CameraSpec") -> list[str]:
+    """One line per field whose value is possible but unusual (outside ``usual``)."""
+    out = []
+    for field, rule in PLAUSIBLE.items():
+        section, name = field.split(".")
+        value = getattr(getattr(camera, section), name)
+        lo, hi = rule.usual
+        if not lo <= value <= hi:
+            out.append(f"{field} {_number(value)}{_unit(rule.unit)} is unusual (most sensors: {_number(lo)} to "
+                       f"{_number(hi)}{_unit(rule.unit)}): check its unit")
+    return out
+
+
+QE_WAVELENGTH_RANGE_NM = (200.0, 1200.0)
+"""Where a silicon sensor's QE table may lie, nm (wavelengths in µm are refused with that hint)."""
+
+
+def check_qe_table(path: str | Path) -> tuple:
+    """(wavelengths nm, QE (3, n), IR-cut (n) or None) of a QE CSV file if it is physically
+    possible: columns ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``, two or more
+    rows, every value a finite number, wavelengths strictly increasing within
+    :data:`QE_WAVELENGTH_RANGE_NM`, QE and transmittance between 0 and 1 (a fraction of the
+    photons). Else a one-line ValueError naming the file, the row and the column."""
+    import warnings
+
+    import numpy as np
+
+    name = Path(path).name
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an empty or short file: refused below, one line
+            table = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"QE table {name}: unreadable ({str(exc).splitlines()[0]})") from None
+    names = table.dtype.names or ()
+    missing = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b") if c not in names]
+    if missing:
+        raise ValueError(f"QE table {name}: lacks column(s) {', '.join(missing)} "
+                         "(expected wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance])")
+    if table.size < 2:
+        raise ValueError(f"QE table {name}: {table.size} row(s); two or more wavelengths are needed")
+    columns = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b", "ir_cut_transmittance") if c in names]
+    for column in columns:
+        values = np.asarray(table[column], float)
+        bad = np.nonzero(~np.isfinite(values))[0]
+        if bad.size:
+            raise ValueError(f"QE table {name}: row {bad[0] + 1} {column} is not a number")
+    wl = np.asarray(table["wavelength_nm"], float)
+    step = np.nonzero(np.diff(wl) <= 0)[0]
+    if step.size:
+        i = step[0]
+        raise ValueError(f"QE table {name}: wavelength_nm must increase row by row: row {i + 2} ({wl[i + 1]:g}) "
+                         f"follows row {i + 1} ({wl[i]:g})")
+    lo, hi = QE_WAVELENGTH_RANGE_NM
+    if wl[0] < lo or wl[-1] > hi:
+        hint = f"; if they are in um, write {wl[0] * 1000:g} to {wl[-1] * 1000:g}" if wl[-1] < 10 else ""
+        raise ValueError(f"QE table {name}: wavelengths {wl[0]:g} to {wl[-1]:g} nm lie outside {lo:g} to {hi:g} nm{hint}")
+    for column in columns[1:]:
+        values = np.asarray(table[column], float)
+        outside = np.nonzero((values < 0) | (values > 1))[0]
+        if outside.size:
+            i = outside[0]
+            hint = "; if the table is in percent, divide it by 100" if 0 <= values.min() and values.max() <= 100 else ""
+            raise ValueError(f"QE table {name}: row {i + 1} {column} is {values[i]:g}: a fraction of the photons, "
+                             f"between 0 and 1{hint}")
+    qe = np.stack([np.asarray(table[f"qe_{c}"], float) for c in ("r", "g", "b")])
+    ir = np.asarray(table["ir_cut_transmittance"], float) if "ir_cut_transmittance" in names else None
+    return wl, qe, ir
 
 
 def packaged_qe(name: str) -> Path | None:
@@ -167,8 +306,21 @@ class SensorSpec(BaseModel):
     def _qe_is_a_relative_csv(cls, value: str) -> str:
         return _check_qe_syntax(value)
 
+    @field_validator("well_capacity_e", "conversion_gain_uv_per_e", "voltage_swing_v", "read_noise_e",
+                     "dark_current_e_per_s", "dsnu_v", "prnu_fraction", mode="before")
+    @classmethod
+    def _plausible(cls, value, info: ValidationInfo):
+        return check_plausible(f"sensor.{info.field_name}", value)
+
     @model_validator(mode="after")
     def _whole_sensor(self, info: ValidationInfo) -> "SensorSpec":
+        if self.read_noise_e >= self.well_capacity_e:
+            raise ValueError(f"read_noise_e {self.read_noise_e:g} e- is not below well_capacity_e "
+                             f"{self.well_capacity_e:g} e-: no signal could rise above the noise (read noise is in "
+                             "electrons, a few e- on CMOS sensors; was it given in uV or DN, or the well in ke-?)")
+        if self.dsnu_v >= self.voltage_swing_v:
+            raise ValueError(f"dsnu_v {self.dsnu_v:g} V is not below voltage_swing_v {self.voltage_swing_v:g} V: "
+                             "the offsets alone would fill the swing (DSNU is in volts; was it meant in mV?)")
         if self.black_level_dn >= self.white_level_dn:
             raise ValueError(f"black_level_dn {self.black_level_dn} must be below the ADC white level "
                              f"{self.white_level_dn} (2^adc_bits - 1 for adc_bits {self.adc_bits})")
@@ -188,6 +340,7 @@ class SensorSpec(BaseModel):
             path = Path(spec_dir) / self.qe
             if not path.is_file():
                 raise ValueError(f"qe {self.qe!r}: no packaged file of that name and no file {path}")
+            check_qe_table(path)  # a user table: physically possible, or refused before anything runs
             self._qe_path = str(path.resolve())
         return self
 
@@ -270,6 +423,11 @@ class ExposureSpec(BaseModel):
     hdr_ratio: float = Field(16.0, gt=1.0, le=1024.0)
     """``hdr`` mode (refused elsewhere): long / short exposure time, fixed, as in the
     two-frame HDR of automotive sensors."""
+
+    @field_validator("max_exposure_s", "exposure_s", mode="before")
+    @classmethod
+    def _plausible(cls, value, info: ValidationInfo):
+        return check_plausible(f"exposure.{info.field_name}", value)
 
     @model_validator(mode="after")
     def _parameters_belong_to_their_mode(self) -> "ExposureSpec":
@@ -417,6 +575,11 @@ class CameraSpec(BaseModel):
         """Sampling Nyquist frequency on the sensor, cycles/mm: 1 / (2 · pixel)."""
         return 500.0 / self.pixel_um
 
+    def cy_per_mrad(self, cy_per_mm: float | None) -> float | None:
+        """A sensor-plane frequency of this camera as an angular one, cycles/mrad in object
+        space (:func:`cy_per_mrad` with its focal length)."""
+        return cy_per_mrad(cy_per_mm, self.optics.focal_length_mm)
+
     def canonical_json(self) -> str:
         """The resolved spec (defaults filled in) as sorted, compact JSON."""
         return json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
@@ -424,6 +587,17 @@ class CameraSpec(BaseModel):
     def sha256(self) -> str:
         """sha256 (hex) of :meth:`canonical_json`: identifies the camera in results."""
         return hashlib.sha256(self.canonical_json().encode("utf-8")).hexdigest()
+
+
+def cy_per_mrad(cy_per_mm: float | None, focal_length_mm: float | None) -> float | None:
+    """A frequency on the sensor (cycles/mm) as an angular frequency in object space
+    (cycles/mrad): × focal length / 1000, since one mrad of the scene spans f µm of the
+    sensor on the axis. The resolution that compares cameras of different focal lengths:
+    an 8 mm lens with 168.6 cy/mm resolves 1.35 cy/mrad, finer than cam12's 229.3 cy/mm
+    behind 4.38 mm (1.00 cy/mrad). None (or NaN) in, None out."""
+    if cy_per_mm is None or focal_length_mm is None or not math.isfinite(cy_per_mm * focal_length_mm):
+        return None
+    return float(cy_per_mm) * float(focal_length_mm) / 1000.0
 
 
 ISP_PRESETS = ("default", "iset-parity")

@@ -1,7 +1,9 @@
 """``benchmark cameras``: list, show and measure (MTF50) the registry's cameras.
 
 Mounted by the main CLI as ``app.add_typer(cameras_app, name="cameras")``. Errors print
-one line and exit with code 2.
+one line and exit with code 2. Every MTF50 shown comes in cycles/mm on the sensor and in
+cycles/mrad in object space (× focal length / 1000: what compares cameras whose focal
+lengths differ), beside the focal length and the field of view.
 """
 
 from __future__ import annotations
@@ -15,9 +17,11 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmark.camera import CameraSpec, list_cameras, load_camera
+from benchmark.cli.help import HELP_SETTINGS
 from metricscenes.cli_support import fail
 
-app = typer.Typer(help="The camera registry: list, show, measure MTF50.", no_args_is_help=True)
+app = typer.Typer(help="The camera registry: list, show, measure MTF50.", no_args_is_help=True,
+                  rich_markup_mode=None, context_settings=HELP_SETTINGS)
 _out = Console()
 
 
@@ -37,6 +41,9 @@ def _summary(cam: CameraSpec) -> dict:
         "width_px": cam.width_px,
         "height_px": cam.height_px,
         "mtf50_group": cam.mtf50_group_cy_per_mm,
+        "mtf50_group_cy_per_mrad": _round(cam.cy_per_mrad(cam.mtf50_group_cy_per_mm), 4),
+        "focal_length_mm": cam.optics.focal_length_mm,
+        "fov_deg": [round(cam.hfov_deg, 2), round(cam.vfov_deg, 2)],
         "sha256": cam.sha256(),
     }
 
@@ -48,12 +55,13 @@ def list_command(as_json: bool = typer.Option(False, "--json", help="Print JSON.
     if as_json:
         print(json.dumps(rows, indent=2))
         return
-    table = Table(title="Cameras (focal length 4.38 mm, active area 2.688 x 1.512 mm)")
-    for col in ("name", "pixel µm", "f-number", "size px", "MTF50 group c/mm", "sha256"):
+    table = Table(title="Cameras (MTF50 group: the paper's, cycles/mm on the sensor and cycles/mrad in object space)")
+    for col in ("name", "pixel µm", "f-number", "size px", "focal mm", "FOV °", "MTF50 group cy/mm", "cy/mrad", "sha256"):
         table.add_column(col)
     for r in rows:
-        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}",
-                      f"{r['width_px']}x{r['height_px']}", f"{r['mtf50_group'] or '-'}", r["sha256"][:12])
+        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['width_px']}x{r['height_px']}",
+                      f"{r['focal_length_mm']:g}", "{:.1f} x {:.1f}".format(*r["fov_deg"]), f"{r['mtf50_group'] or '-'}",
+                      _cell(r["mtf50_group_cy_per_mrad"], ".3f"), r["sha256"][:12])
     _out.print(table)
 
 
@@ -135,7 +143,10 @@ def mtf_command(
             "name": cam.name,
             "pixel_um": cam.pixel_um,
             "f_number": cam.f_number,
+            "focal_length_mm": cam.optics.focal_length_mm,
+            "fov_deg": [round(cam.hfov_deg, 2), round(cam.vfov_deg, 2)],
             "mtf50_cy_per_mm": round(m["mtf50_cy_per_mm"], 2),
+            "mtf50_cy_per_mrad": _round(cam.cy_per_mrad(m["mtf50_cy_per_mm"]), 4),
             "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(cam.pixel_um, cam.f_number), 2),
             "mtf50_group": cam.mtf50_group_cy_per_mm,
             "nyquist_cy_per_mm": round(500.0 / cam.pixel_um, 2),
@@ -151,27 +162,31 @@ def mtf_command(
     if as_json:
         print(json.dumps(results, indent=2))
         return
-    title = "MTF50 (cycles/mm on the sensor); analytic = diffraction x pixel, polychromatic"
+    title = ("MTF50 (cycles/mm on the sensor; cy/mrad: in object space, x focal length / 1000); "
+             "analytic = diffraction x pixel, polychromatic")
     if tagged:
         title += f"; ISP {isp_name or 'of each camera'}, e-SFR {esfr}"
     table = Table(title=title)
-    for col in ("name", "pixel µm", "f-number", "measured", "analytic", "paper group", "Nyquist", "MTF30", "MTF10"):
+    for col in ("name", "pixel µm", "f-number", "focal mm", "FOV °", "measured", "cy/mrad", "analytic", "paper group",
+                "Nyquist", "MTF30", "MTF10"):
         table.add_column(col, justify="right")
     for r in results:
-        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['mtf50_cy_per_mm']:.1f}",
-                      f"{r['mtf50_analytic_cy_per_mm']:.1f}", f"{r['mtf50_group'] or '-'}", f"{r['nyquist_cy_per_mm']:.0f}",
+        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['focal_length_mm']:g}",
+                      "{:.1f} x {:.1f}".format(*r["fov_deg"]), f"{r['mtf50_cy_per_mm']:.1f}",
+                      _cell(r["mtf50_cy_per_mrad"], ".3f"), f"{r['mtf50_analytic_cy_per_mm']:.1f}",
+                      f"{r['mtf50_group'] or '-'}", f"{r['nyquist_cy_per_mm']:.0f}",
                       _cell(r["mtf30_cy_per_mm"], ".1f"), _cell(r["mtf10_cy_per_mm"], ".1f"))
     _out.print(table)
-    _out.print("measured = MTF50; MTF30, MTF10 read off the same curve ('-': not reached below 1 cycle/pixel)",
-               highlight=False)
+    _out.print("measured = MTF50; MTF30, MTF10 read off the same curve ('-': not reached below 1 cycle/pixel); "
+               "cy/mrad compares cameras of different focal lengths, cy/mm does not", highlight=False)
     for r in results:
         per_px = ", ".join(f"MTF{n} {_cell(r[f'mtf{n}_cy_per_px'], '.3f')}" for n in (50, 30, 10))
         _out.print(f"{r['name']} in cycles/pixel (Nyquist 0.5): {per_px}", highlight=False)
 
 
-def _round(value: float, digits: int) -> float | None:
-    """Rounded, or None (JSON null) for NaN: a level the curve does not reach."""
-    return None if value != value else round(float(value), digits)
+def _round(value: float | None, digits: int) -> float | None:
+    """Rounded, or None (JSON null) for None or NaN: a level the curve does not reach."""
+    return None if value is None or value != value else round(float(value), digits)
 
 
 def _cell(value: float | None, fmt: str) -> str:

@@ -49,6 +49,17 @@ def _save_targets(save: Path, images: list[Path]) -> list[Path]:
     return targets
 
 
+def _checked_targets(save: Path, images: list[Path]) -> list[Path]:
+    """:func:`_save_targets`, none of them inside a collection, run, sweep or leaderboard
+    (:func:`metricscenes.outputs.check_output`: a drawn image never replaces a run's)."""
+    from metricscenes.outputs import check_output
+
+    targets = _save_targets(save, images)
+    for target in targets:
+        check_output(target, "--save")
+    return targets
+
+
 def detect(
     images: list[Path] = typer.Argument(..., help="Image files (PNG, JPEG, ...)."),
     model: str = typer.Option("yolov5n-dynamic", help="Registry name (found in --model-dir / $METRICSCENES_MODEL_DIR) or path to an ONNX file."),
@@ -64,7 +75,7 @@ def detect(
     """Detect objects in images with a YOLOv5/YOLOv8/YOLOX ONNX model."""
     err = Console(stderr=True)
     try:
-        targets = _save_targets(save, images) if save is not None else []
+        targets = _checked_targets(save, images) if save is not None else []
         detector = load_detector(model, input_size=input_size, threads=threads, model_dir=model_dir, class_map=class_map)
         arrays = [_read_rgb(p) for p in images]
         results = detector.detect(arrays, conf_threshold=conf, iou_threshold=iou)

@@ -13,6 +13,7 @@ import typer
 
 from benchmark.leaderboard.schema import SubmissionError
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.suggest import did_you_mean
 from metricscenes.cli_support import fail
 
 
@@ -37,6 +38,7 @@ def submit(
     )  # fmt: skip
 
     try:
+        check_leaderboard_dir(leaderboard, "--leaderboard")
         if check is not None:
             if results_dir is not None or name is not None:
                 fail("--check FILE takes no RESULTS_DIR or --name")
@@ -53,7 +55,7 @@ def submit(
         groups = group_by_camera(find_runs(results_dir))
         if camera is not None:
             if camera not in groups:
-                fail(f"camera {camera!r} is not in {results_dir} (cameras: {', '.join(groups)})")
+                fail(f"camera {camera!r} is not in {results_dir} (cameras: {', '.join(groups)}){did_you_mean(camera, groups)}")
             groups = {camera: groups[camera]}
         if len(groups) > 1 and "{camera}" not in name:
             fail(f"{results_dir} holds {len(groups)} cameras ({', '.join(groups)}): put {{camera}} in --name or choose one with --camera")
@@ -71,6 +73,18 @@ def submit(
             typer.echo(f"wrote {path} (day OD50 {day}, {n_resamples} bootstrap resamples; conditions {', '.join(sorted(sub['conditions']))}{note})")
     except (SubmissionError, ValueError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+    except OSError as exc:  # the leaderboard folder unwritable, disk full: one line
+        fail(f"cannot write into {leaderboard}: {exc.strerror or type(exc).__name__}")
+
+
+def check_leaderboard_dir(folder: Path, what: str) -> Path:
+    """A leaderboard folder to read or write: a folder (or none yet), not a collection,
+    run or sweep folder nor inside one (ValueError, one line)."""
+    from metricscenes.outputs import LEADERBOARD, check_output
+
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{what} {folder} is a file, not a leaderboard folder (one that holds submissions/)")
+    return check_output(folder, what, own=LEADERBOARD)
 
 
 def _od50_text(cond: dict) -> str:
@@ -92,9 +106,15 @@ def leaderboard_cmd(
     if not dir.is_dir():
         fail(f"{dir}: no such leaderboard folder")
     try:
+        check_leaderboard_dir(dir, "--dir")
+    except ValueError as exc:
+        fail(str(exc))
+    try:
         readme, page = render_leaderboard(dir)
     except (SubmissionError, ValueError) as exc:
         fail(f"{str(exc).splitlines()[0]} (the table was not changed)")
+    except OSError as exc:
+        fail(f"cannot write into {dir}: {exc.strerror or type(exc).__name__} (the table was not changed)")
     typer.echo(f"wrote {readme} and {page}")
 
 

@@ -11,13 +11,16 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmark.cli.cameras import app as cameras_app
+from benchmark.cli.help import HELP_SETTINGS
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.suggest import did_you_mean
 from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
+                  rich_markup_mode=None, context_settings=HELP_SETTINGS,  # help over the terminal's width
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
 app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show, measure MTF50.")
 cli_detect.register(app)
@@ -33,6 +36,24 @@ SUBSET_ENV_HELP = "a quick try on some environments only: ids and ranges such as
 SUBSET_DIST_HELP = "a quick try at some distances only, in metres: 25,50 (marked as a subset run)"
 CLASS_MAP_HELP = ("for a detector whose classes are not COCO's 80: the COCO class of each model class, in order "
                   "('car' for a single-class car detector, 'person,-,car'; '-' drops one; docs/detection.md)")
+MODEL_DIR_HELP = "folder holding the registry's model files (default: $METRICSCENES_MODEL_DIR)"
+
+
+def unknown_condition(condition: str, known) -> str:
+    """The one-line refusal of a condition the collection lacks, with a "did you mean" (never taken silently)."""
+    known = list(known)
+    return f"unknown condition {condition!r} (this collection has: {', '.join(known)}){did_you_mean(condition, known)}"
+
+
+def camera_text(camera: dict) -> str:
+    """MTF50 in both units, focal length and field of view of a results.json ``camera`` ("" for
+    a record without them)."""
+    if camera.get("focal_length_mm") is None or camera.get("mtf50_cy_per_mrad") is None:
+        return ""
+    fov = camera.get("fov_deg") or []
+    where = f"focal length {camera['focal_length_mm']:g} mm" + (", field of view {:.1f}° x {:.1f}°".format(*fov) if fov else "")
+    return (f"MTF50 {camera['mtf50_cy_per_mm']:.1f} cy/mm on the sensor = {camera['mtf50_cy_per_mrad']:.3f} cy/mrad in "
+            f"object space ({where}; {camera.get('mtf50_source')})")
 
 
 def subset_text(subset: dict) -> str:
@@ -58,22 +79,25 @@ def run(
     environments: Annotated[Optional[str], typer.Option(help=SUBSET_ENV_HELP)] = None,
     distances: Annotated[Optional[str], typer.Option(help=SUBSET_DIST_HELP)] = None,
     class_map: Annotated[Optional[str], typer.Option(help=CLASS_MAP_HELP)] = None,
+    model_dir: Annotated[Optional[Path], typer.Option(help=MODEL_DIR_HELP)] = None,
 ) -> None:
     """Simulate one camera on a collection, detect cars, print AP per distance."""
     from benchmark.camera import load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.camera.exposure import format_exposure, parse_exposure, with_exposure
     from benchmark.experiments.run import check_out_dir, run_camera, subset_collection
+    from metricscenes.outputs import RUN, check_output
     from metricscenes.store import Collection, CollectionError
 
     try:
         check_out_dir(out)
+        check_output(out, "--out", own=RUN)  # a new folder or an earlier run's, never a sweep's or the leaderboard
         policy = parse_exposure(exposure) if exposure is not None else None
         cam = with_exposure(load_camera(camera), policy)
         col = subset_collection(Collection.open(collection), environments, distances)
         if condition not in col.condition_names:
-            fail(f"unknown condition {condition!r} (this collection has: {', '.join(col.condition_names)})")
-        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
+            fail(unknown_condition(condition, col.condition_names))
+        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map, model_dir=model_dir)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
     try:  # a damaged array or a broken model is found on the way: nothing is written (run_camera stages)
@@ -93,6 +117,8 @@ def run(
         table.add_row(f"{row.distance_m:g}", f"{row.ap:.3f}", f"{row.ap50:.3f}", str(row.n_images))
     console.print(table)
     console.print(od50_text(*results.ap_curve()))
+    if camera_text(results.camera.model_dump()):
+        console.print(camera_text(results.camera.model_dump()), highlight=False)
     if results.subset:
         console.print(subset_text(results.subset.model_dump()))
     console.print(f"wrote {out / 'results.json'}")
@@ -121,6 +147,7 @@ def sweep(
     captures_from: Annotated[Optional[Path], typer.Option(
         help="another sweep folder on this collection: detect on its runs' camera images where they match "
              "(same camera, condition and seed) instead of simulating the camera again")] = None,
+    model_dir: Annotated[Optional[Path], typer.Option(help=MODEL_DIR_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
     from benchmark.experiments import sweep as sweep_module
@@ -129,10 +156,12 @@ def sweep(
     from benchmark.camera.exposure import format_exposure, parse_exposure
     from benchmark.experiments.run import check_out_dir, subset_collection
     from metricscenes.backends import BackendError, runs_in_process, threads_per_unit
+    from metricscenes.outputs import SWEEP, check_output
     from metricscenes.store import Collection, CollectionError
 
     try:
         check_out_dir(out)
+        check_output(out, "--out", own=SWEEP)  # a new folder or an earlier sweep's
         policy = parse_exposure(exposure) if exposure is not None else None
         names = camera_names() if cameras.strip().lower() == "all" else [c.strip() for c in cameras.split(",") if c.strip()]
         cams = [load_camera(name) for name in names]
@@ -141,12 +170,12 @@ def sweep(
         known = col.condition_names
         for condition in conds:
             if condition not in known:
-                fail(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
+                fail(unknown_condition(condition, known))
         if mtf_source not in sweep_module.MTF50_SOURCES:
             fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF50_SOURCES)}, got {mtf_source!r}")
         if not runs_in_process(workers, scheduler):  # each worker loads the detector again, with its share of the CPUs
             threads = threads_per_unit(threads, workers, scheduler)
-        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map)
+        detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map, model_dir=model_dir)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
     if not cams or not conds:
@@ -164,19 +193,22 @@ def sweep(
     except (ValueError, DetectorError, CollectionError, BackendError, OSError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     _, od50_table = sweep_module.load_sweep(out)
-    title = f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments"
+    title = (f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments; MTF50 in cy/mm "
+             "on the sensor and cy/mrad in object space (f: focal length, mm)")
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
     table = Table(title=title)
     table.add_column("camera")
-    table.add_column("MTF50 (cy/mm)", justify="right")
+    table.add_column("MTF50 (cy/mm)", justify="right", no_wrap=True)
+    table.add_column("cy/mrad (f)", justify="right", no_wrap=True)
     for condition in conds:
         table.add_column(condition, justify="right")
     for camera_name, rows in od50_table.groupby("camera", sort=False):
         by_condition = rows.set_index("condition")
         cells = [sweep_module.od50_cell(by_condition.loc[condition]) for condition in conds]
-        mtf = rows["mtf50_cy_per_mm"].iloc[0]
-        table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})", *cells)
+        mtf, mrad = rows["mtf50_cy_per_mm"].iloc[0], rows["mtf50_cy_per_mrad"].iloc[0]
+        table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})",
+                      f"{mrad:.3f} ({rows['focal_length_mm'].iloc[0]:g})", *cells)
     console.print(table)
     if getattr(col, "subset", None):
         console.print(subset_text(col.subset))
@@ -185,17 +217,31 @@ def sweep(
 
 @app.command()
 def report(
-    results_dir: Annotated[Path, typer.Argument(help="a `benchmark sweep` folder or a `benchmark run` folder")],
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="HTML page (default RESULTS_DIR/report.html)")] = None,
+    results_dirs: Annotated[list[Path], typer.Argument(
+        help="`benchmark sweep` or `benchmark run` folders, one or several (of one collection and detector)",
+        metavar="RESULTS_DIR")],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help=(
+        "HTML page (default RESULTS_DIR/report.html for one folder; required for several)"))] = None,
 ) -> None:
-    """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips."""
+    """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips (of one folder, or of
+    several run and sweep folders side by side)."""
     from benchmark.experiments.report import report as write_report
+    from metricscenes.outputs import RUN, SWEEP, check_output, folder_kind
 
-    if not results_dir.is_dir():
-        fail(f"results folder not found: {results_dir}")
-    try:
+    for results_dir in results_dirs:
+        if not results_dir.is_dir():
+            fail(f"results folder not found: {results_dir}")
+        if folder_kind(results_dir) not in (RUN, SWEEP):
+            fail(f"{results_dir} is neither a sweep folder (sweep.csv) nor a run folder (results.json)")
+    if out is None and len(results_dirs) > 1:
+        fail(f"{len(results_dirs)} results folders: name the page with --out (e.g. --out reports/mine.html)")
+    if out is not None and (out.suffix.lower() != ".html" or out.is_dir()):
+        fail(f"--out {out}: the report is an HTML page; name a file ending in .html")
+    given = results_dirs[0] if len(results_dirs) == 1 else None  # several: the page goes outside all of them
+    try:  # the page, figures/ and report_table.csv: in RESULTS_DIR, or outside every collection, run and leaderboard
+        check_output(out if out is not None else results_dirs[0] / "report.html", "--out", given=given)
         with err.status("writing the report"):
-            page = write_report(results_dir, out)
+            page = write_report(results_dirs if len(results_dirs) > 1 else results_dirs[0], out)
     except (ValueError, OSError, KeyError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     console.print(f"wrote {page} (figures in {page.parent / 'figures'})")

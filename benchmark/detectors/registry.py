@@ -58,7 +58,7 @@ def resolve_model(model: str | Path, model_dir: Path | None = None) -> tuple[Pat
         entry = entries[model]
         folder = model_dir or default_model_dir()
         if folder is None:
-            raise DetectorError(f"model '{model}' is a registry name; set {MODEL_DIR_ENV} or pass model_dir to locate {entry.file}")
+            raise DetectorError(f"model '{model}' is a registry name; set {MODEL_DIR_ENV} or pass --model-dir (model_dir in Python) to locate {entry.file}")
         path = Path(folder) / entry.file
     else:
         path = Path(model)

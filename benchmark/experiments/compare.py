@@ -18,11 +18,22 @@ COCO's per-image matches (:func:`benchmark.scoring.bootstrap.weighted_ap`). Inte
 **Censoring.** When A's or B's OD50 is censored (AP does not cross 0.5 inside the measured
 distances: "> 200 m" or "< 25 m"), ΔOD50 in metres is not measured: the verdict says so and
 the ΔAP per distance carries the comparison.
+
+**Enough cars behind an AP.** AP is computed from every detection down to score 0.001, so a
+camera that sees nothing still gets an AP from a few low-score boxes (0.09 from one box of
+score 0.02). A difference at a distance is *called* only when its 95 % interval excludes 0
+**and** the camera with the higher AP found at least :func:`cars_needed` of the cars there
+(:data:`MIN_FOUND_CARS`, and :data:`MIN_FOUND_FRACTION` of them): a car detection of score ≥
+:data:`FOUND_SCORE` overlapping the car's box at IoU ≥ :data:`FOUND_IOU`
+(:func:`benchmark.scoring.detection_rates`, ``benchmark score``'s working point). Where
+neither camera finds that many, both are *blind* there, and the verdict says so ("both
+blind at night beyond 25 m") instead of calling a difference (docs/detection.md).
 """
 
 from __future__ import annotations
 
 import json
+import math
 import textwrap
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,11 +43,39 @@ import numpy as np
 import typer
 
 from benchmark.result_files import ResultsFileError, RunFolder, read_results, read_sweep_record
-from benchmark.scoring import ap_by_distance, format_od50, od50, od50_censoring
+from benchmark.scoring import ap_by_distance, detection_rates, format_od50, od50, od50_censoring
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
+from benchmark.suggest import did_you_mean
 
 COMPARE_FORMAT = "metricscenes-compare/1"
 CONDITION_WORDS = {"day": "by day", "night": "at night", "dusk": "at dusk"}
+MIN_FOUND_CARS = 3
+"""Fewest cars the camera with the higher AP must have found at a distance for a difference there to be called."""
+MIN_FOUND_FRACTION = 0.2
+"""... and at least this fraction of the cars at that distance (10 of 50 on metric-300, 3 of 10 on quick)."""
+FOUND_SCORE = 0.25
+"""A car is found by a car detection of at least this score (``benchmark score``'s working threshold) ..."""
+FOUND_IOU = 0.5
+"""... overlapping its ground-truth box at least this much."""
+
+
+def cars_needed(n_cars: int) -> int:
+    """Found cars needed behind an AP at a distance holding ``n_cars`` cars:
+    max(:data:`MIN_FOUND_CARS`, ⌈:data:`MIN_FOUND_FRACTION` × n_cars⌉)."""
+    return max(MIN_FOUND_CARS, math.ceil(MIN_FOUND_FRACTION * n_cars - 1e-9))
+
+
+def blind_below(n_cars: int) -> int:
+    """A camera that found fewer than this many of ``n_cars`` cars is blind there:
+    :func:`cars_needed`, but never more than half the cars (with two cars per distance, one
+    found car is not blindness, though no difference can be called on it)."""
+    return min(cars_needed(n_cars), max(1, math.ceil(n_cars / 2)))
+
+
+def found_cars(side: "Side") -> dict[float, tuple[int, int]]:
+    """Per distance: (cars found, cars) of one run (:data:`FOUND_SCORE`, :data:`FOUND_IOU`)."""
+    rows = detection_rates(side.groundtruth, side.detections, score_threshold=FOUND_SCORE, iou_threshold=FOUND_IOU)
+    return {float(r["distance_m"]): (int(r["detected"]), int(r["n_images"])) for r in rows}
 
 
 class CompareError(ValueError):
@@ -81,7 +120,10 @@ def resolve_run(path: str | Path, camera: str | None = None, condition: str = "d
     candidate = path / "runs" / f"{camera}-{condition}"
     if (candidate / "results.json").is_file():
         return candidate
-    raise CompareError(f"{path}: no run of camera {camera!r} in condition {condition!r}")
+    held = [p.name for p in sorted((path / "runs").glob("*-*")) if (p / "results.json").is_file()]
+    hint = did_you_mean(f"{camera}-{condition}", held)
+    raise CompareError(f"{path}: no run of camera {camera!r} in condition {condition!r}"
+                       + (f" (runs there: {', '.join(held)}){hint}" if held else ""))
 
 
 def load_side(folder: str | Path) -> Side:
@@ -167,13 +209,20 @@ def compare_runs(
         with np.errstate(invalid="ignore"):
             d_od[k] = od50(distances, ap_ab[0]) - od50(distances, ap_ab[1])
     per_distance = []
+    found = {"a": found_cars(a), "b": found_cars(b)}
     for j, dm in enumerate(distances):
         col = d_ap[:, j][np.isfinite(d_ap[:, j])]
         lo, hi = percentile_interval(col, confidence_level)
         delta = float(sides["a"]["ap"][j] - sides["b"]["ap"][j])
+        (found_a, n_cars), (found_b, _) = found["a"].get(float(dm), (0, 0)), found["b"].get(float(dm), (0, 0))
+        needed = cars_needed(n_cars)
+        backed = (found_a if delta > 0 else found_b) >= needed  # the higher AP rests on found cars
         per_distance.append({"distance_m": float(dm), "ap_a": float(sides["a"]["ap"][j]), "ap_b": float(sides["b"]["ap"][j]),
                              "delta_ap": delta, "sd": float(np.std(col, ddof=1)) if col.size > 1 else None,
-                             "ci95": [lo, hi]})
+                             "ci95": [lo, hi], "n_cars": n_cars, "found_a": found_a, "found_b": found_b,
+                             "cars_needed": needed, "blind_below": blind_below(n_cars),
+                             "resolved": bool((lo > 0 or hi < 0) and backed),
+                             "blind": bool(max(found_a, found_b) < blind_below(n_cars))})
     censored = bool(sides["a"]["censored"] or sides["b"]["censored"])
     finite = d_od[np.isfinite(d_od)]
     delta_od = float(sides["a"]["od50_m"] - sides["b"]["od50_m"])
@@ -195,6 +244,8 @@ def compare_runs(
         "seed": int(seed),
         "confidence_level": confidence_level,
         "paired": paired,
+        "found_rule": {"min_cars": MIN_FOUND_CARS, "min_fraction": MIN_FOUND_FRACTION, "score": FOUND_SCORE,
+                       "iou": FOUND_IOU},
         "per_distance": per_distance,
         "delta_od50": od_block,
     }
@@ -212,14 +263,93 @@ def _when(cond_a: str, cond_b: str) -> tuple[str, str]:
     return "", f" ({cond_a} vs {cond_b})"
 
 
+def _interval_excludes_zero(row: dict) -> bool:
+    return row["ci95"][0] > 0 or row["ci95"][1] < 0
+
+
+def _resolved(row: dict) -> bool:
+    """A difference called at this distance: the interval excludes 0 and the higher AP rests
+    on enough found cars (rows without the counts: the interval alone)."""
+    return row.get("resolved", _interval_excludes_zero(row))
+
+
+def blind_from(result: dict) -> float | None:
+    """The nearest distance from which both cameras are blind at every measured distance
+    (neither found :func:`blind_below` cars), or None."""
+    rows = sorted(result["per_distance"], key=lambda r: r["distance_m"])
+    start = None
+    for row in reversed(rows):
+        if not row.get("blind", False):
+            break
+        start = row["distance_m"]
+    return start
+
+
+def _blind_text(result: dict, when: str) -> str:
+    """"; both blind at night beyond 25 m (at every distance beyond it, neither camera found 3
+    of the 10 cars ...)", or "" (blind at every distance: :func:`verdict` says it alone)."""
+    start = blind_from(result)
+    if start is None:
+        return ""
+    rows = sorted(result["per_distance"], key=lambda r: r["distance_m"])
+    before = [r["distance_m"] for r in rows if r["distance_m"] < start]
+    row = next(r for r in rows if r["distance_m"] == start)
+    return f"; both blind{when} beyond {before[-1]:g} m (at every distance beyond it, {_found_rule_text(result, row)})"
+
+
+def _found_rule_text(result: dict, row: dict) -> str:
+    rule = result.get("found_rule", {"score": FOUND_SCORE, "iou": FOUND_IOU})
+    needed = row.get("blind_below", row["cars_needed"])
+    how_many = "any" if needed == 1 else str(needed)
+    return (f"neither camera found {how_many} of the {row['n_cars']} cars: a car detection of score "
+            f">= {rule['score']:g} on the car at IoU >= {rule['iou']:g}")
+
+
+def _unbacked_text(result: dict) -> str:
+    """"; at 150 m the interval excludes 0 but ...: not called" for the distances whose
+    interval alone would call a difference that too few found cars carry (blind ones aside:
+    the blind clause says it)."""
+    rows = [r for r in result["per_distance"]
+            if _interval_excludes_zero(r) and not _resolved(r) and not r.get("blind", False)]
+    if not rows:
+        return ""
+    where = ", ".join(format(r["distance_m"], "g") for r in rows)
+    return (f"; at {where} m the AP interval excludes 0 but the higher AP rests on fewer than "
+            f"{rows[0]['cars_needed']} found cars: not called")
+
+
 def verdict(result: dict) -> str:
-    """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)"."""
+    """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)",
+    "... AP differs at 50 m ...", or "both blind at night beyond 25 m" (see the module docstring)."""
+    a, b = result["a"], result["b"]
+    when, _ = _when(a["condition"], b["condition"])
+    when = f" {when}" if when else ""
+    rows = result["per_distance"]
+    if rows and blind_from(result) == min(r["distance_m"] for r in rows):
+        first = min(rows, key=lambda r: r["distance_m"])
+        last = max(r["distance_m"] for r in rows)
+        return (f"{a['label']} and {b['label']} are both blind{when} at every measured distance "
+                f"({first['distance_m']:g} to {last:g} m: {_found_rule_text(result, first)}): no difference is called")
+    return _od50_verdict(result) + _unbacked_text(result) + _blind_text(result, when) + _too_few_text(result)
+
+
+def _too_few_text(result: dict) -> str:
+    """"; with 2 cars per distance no difference at a distance can be called (3 found cars
+    needed)" where no distance holds enough cars for the rule, else ""."""
+    rows = result["per_distance"]
+    if not rows or any(r.get("n_cars", math.inf) >= r.get("cars_needed", 0) for r in rows):
+        return ""
+    return (f"; with {max(r['n_cars'] for r in rows)} cars per distance no difference at a distance can be called "
+            f"({rows[0]['cars_needed']} found cars needed)")
+
+
+def _od50_verdict(result: dict) -> str:
     a, b, od = result["a"], result["b"], result["delta_od50"]
     when, suffix = _when(a["condition"], b["condition"])
     when = f" {when}" if when else ""
     pct = f"{100 * result['confidence_level']:g} %"
     if od["delta_m"] is None:
-        resolved = [r for r in result["per_distance"] if r["ci95"][0] > 0 or r["ci95"][1] < 0]
+        resolved = [r for r in result["per_distance"] if _resolved(r)]
         od_a = format_od50(a["od50_m"], a["censored"], a["bound_m"])
         od_b = format_od50(b["od50_m"], b["censored"], b["bound_m"])
         where = ", ".join(format(r["distance_m"], "g") for r in resolved)
@@ -308,23 +438,34 @@ def register(app) -> None:
         seed: Annotated[int, typer.Option(help="bootstrap seed")] = 0,
     ) -> None:
         """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict."""
+        from metricscenes.outputs import OutputError, check_output
+
         console, err = Console(), Console(stderr=True)
         try:
+            if out is not None:  # not into a collection, a run, a sweep or the leaderboard
+                check_output(out, "--out")
             with err.status("paired bootstrap"):
                 result = compare_paths(a, b, cameras=camera or (), condition=condition, n_resamples=resamples, seed=seed)
-        except (CompareError, ValueError, OSError) as exc:
+        except (CompareError, OutputError, ValueError, OSError) as exc:
             fail(str(exc).splitlines()[0])
         ra, rb = result["a"], result["b"]
         table = Table(title=f"{ra['label']} − {rb['label']} · paired bootstrap, {result['n_resamples']} resamples "
                             f"over {result['n_environments']} environments")
-        for name in ("distance (m)", f"AP {ra['label']}", f"AP {rb['label']}", "ΔAP ± SD", "95 %"):
+        for name in ("distance (m)", f"AP {ra['label']}", f"AP {rb['label']}", "ΔAP ± SD", "95 %",
+                     f"cars found {ra['label']}", f"cars found {rb['label']}", "called"):
             table.add_column(name, justify="right")
         for r in result["per_distance"]:
+            called = "yes" if r["resolved"] else ("blind" if r["blind"] else "no")
             table.add_row(f"{r['distance_m']:g}", f"{r['ap_a']:.3f}", f"{r['ap_b']:.3f}",
-                          f"{r['delta_ap']:+.3f} ± {r['sd'] or 0:.3f}", f"{r['ci95'][0]:+.3f} to {r['ci95'][1]:+.3f}")
+                          f"{r['delta_ap']:+.3f} ± {r['sd'] or 0:.3f}", f"{r['ci95'][0]:+.3f} to {r['ci95'][1]:+.3f}",
+                          f"{r['found_a']}/{r['n_cars']}", f"{r['found_b']}/{r['n_cars']}", called)
         console.print(table)
         console.print(f"OD50: {ra['label']} {format_od50(ra['od50_m'], ra['censored'], ra['bound_m'])}, "
                       f"{rb['label']} {format_od50(rb['od50_m'], rb['censored'], rb['bound_m'])}", highlight=False)
+        console.print(f"cars found: a car detection of score >= {FOUND_SCORE:g} on the car at IoU >= {FOUND_IOU:g}; "
+                      f"a difference is called where the 95 % interval excludes 0 and the higher AP rests on at least "
+                      f"{MIN_FOUND_CARS} found cars ({MIN_FOUND_FRACTION:.0%} of them where more); 'blind': neither camera "
+                      "found that many (docs/detection.md)", highlight=False)
         console.print(result["verdict"], highlight=False)
         if out is not None:
             out.mkdir(parents=True, exist_ok=True)

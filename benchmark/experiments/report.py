@@ -1,13 +1,20 @@
-"""``benchmark report``: one self-contained HTML page from a sweep or a single run folder.
+"""``benchmark report``: one self-contained HTML page from sweep and run folders.
 
-The page holds AP-vs-distance curves per condition (one line per camera), the System
-Performance Maps and OD50 vs MTF50 (:mod:`benchmark.experiments.spm`; sweep folders with two or
-more MTF50 values only), a table (camera, MTF50, condition, OD50 ± SD, AP per
-distance), and per distance a strip of camera images, cropped around the car at the
+One folder (a sweep or a single run) or several (:func:`load_many`: runs and sweeps of one
+collection and one detector, e.g. ``benchmark report results/mine-day results/quick``) make
+one page. It holds AP-vs-distance curves per condition (one line per camera), the System
+Performance Maps and OD50 vs MTF50 (:mod:`benchmark.experiments.spm`; two or more MTF50
+values only), a table (camera, MTF50 in cycles/mm on the sensor and cycles/mrad in object
+space, focal length and field of view, condition, OD50 ± SD, AP per distance), and per
+distance a strip of camera images, cropped around the car at the
 same field of view for every camera, with the ground-truth box (green) and the best
 car detection (red, with its score). Every image is embedded as base64 PNG and the
 page loads nothing from elsewhere; the figures are also written as PNG and SVG next
 to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
+
+Where the cameras differ in focal length the MTF50 axis of the figures is the angular one
+(cycles/mrad in object space, :func:`benchmark.experiments.spm.mtf50_axis`); the captions say
+which axis each figure uses.
 """
 
 from __future__ import annotations
@@ -83,13 +90,95 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
     return table, od50, {(cam.name, results.condition): root}, meta
 
 
-def plot_ap_curves(table: pd.DataFrame, out=None):
+def load_many(results_dirs) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[str, str], Path], dict]:
+    """:func:`load_results` of several sweep and run folders as one: their tables side by side,
+    refused in one line where they come from different collections or detectors (a page
+    compares cameras, not scenes or detectors) or hold the same camera × condition twice."""
+    folders = [Path(p) for p in results_dirs]
+    if not folders:
+        raise ValueError("no results folder given")
+    loaded = [load_results(f) for f in folders]
+    if len(loaded) == 1:
+        return with_optics(*loaded[0])
+    first_folder, (_, _, _, first) = folders[0], loaded[0]
+    for folder, (_, _, _, meta) in zip(folders[1:], loaded[1:]):
+        for what, key in (("collection", lambda m: m.get("collection", {}).get("manifest_sha256")),
+                          ("detector", lambda m: (m.get("detector", {}).get("sha256"),
+                                                  str(m.get("detector", {}).get("input_size"))))):
+            if key(meta) != key(first):
+                raise ValueError(f"{folder} and {first_folder} come from different {what}s: one report compares "
+                                 "cameras on one collection with one detector")
+    seen: dict[tuple[str, str], Path] = {}
+    for folder, (_, _, runs, _) in zip(folders, loaded):
+        for key in runs:
+            if key in seen:
+                raise ValueError(f"camera {key[0]} under {key[1]} is in both {seen[key]} and {folder}: keep one")
+            seen[key] = folder
+    table = pd.concat([t for t, _, _, _ in loaded], ignore_index=True)
+    od50 = pd.concat([o for _, o, _, _ in loaded], ignore_index=True)
+    runs = {k: v for _, _, r, _ in loaded for k, v in r.items()}
+    meta = dict(first)
+    for key in ("seed", "n_resamples", "mtf_source"):  # the page's facts: one value, or each folder's
+        values = list(dict.fromkeys(str(m.get(key)) for _, _, _, m in loaded if m.get(key) is not None))
+        meta[key] = values[0] if len(values) == 1 else (" / ".join(values) or None)
+    return with_optics(table, od50, runs, meta)
+
+
+def camera_optics(runs: dict[tuple[str, str], Path]) -> dict[str, dict]:
+    """Per camera: focal length (mm) and field of view (degrees, h × v) from one of its runs'
+    results.json (recorded there, else from the spec it holds); empty where no run says."""
+    from benchmark.camera import CameraSpec, camera_from_dict
+
+    out: dict[str, dict] = {}
+    for (camera, _), folder in runs.items():
+        if camera in out or not (Path(folder) / "results.json").is_file():
+            continue
+        try:
+            record = read_results(Path(folder) / "results.json").camera
+        except (OSError, ValueError):
+            continue
+        if record.focal_length_mm is not None and record.fov_deg:
+            out[camera] = {"focal_length_mm": record.focal_length_mm, "fov_deg": list(record.fov_deg)}
+            continue
+        spec = {k: v for k, v in (record.spec or {}).items()}
+        spec["sensor"] = {k: v for k, v in dict(spec.get("sensor") or {}).items()
+                          if k not in CameraSpec.model_fields["sensor"].annotation.model_computed_fields}
+        try:
+            cam = camera_from_dict(spec)
+        except ValueError:
+            continue
+        out[camera] = {"focal_length_mm": cam.optics.focal_length_mm, "fov_deg": [cam.hfov_deg, cam.vfov_deg]}
+    return out
+
+
+def with_optics(table: pd.DataFrame, od50: pd.DataFrame, runs: dict, meta: dict) -> tuple:
+    """The tables with ``focal_length_mm`` and ``mtf50_cy_per_mrad`` filled in where a sweep
+    written before they were recorded (or a single run) lacks them, from the runs'
+    results.json, and ``fov_deg`` ("h × v") on the OD50 table; (table, od50, runs, meta)."""
+    optics = camera_optics(runs)
+
+    def fill(frame: pd.DataFrame) -> pd.DataFrame:
+        frame = frame.copy()
+        recorded = frame["focal_length_mm"] if "focal_length_mm" in frame.columns else pd.Series(np.nan, frame.index)
+        read = frame["camera"].map(lambda c: optics.get(c, {}).get("focal_length_mm", np.nan))
+        frame["focal_length_mm"] = recorded.astype(float).fillna(read.astype(float))
+        frame["mtf50_cy_per_mrad"] = frame["mtf50_cy_per_mm"].astype(float) * frame["focal_length_mm"] / 1000.0
+        return frame
+
+    od50 = fill(od50)
+    od50["fov_deg"] = od50["camera"].map(lambda c: "{:.1f} × {:.1f}".format(*optics[c]["fov_deg"]) if c in optics else "–")
+    return fill(table), od50, runs, meta
+
+
+def plot_ap_curves(table: pd.DataFrame, out=None, *, axis: str = "sensor"):
     """AP vs distance, one panel per condition, one line per camera (seaborn), cameras
-    coloured by MTF50 (paper Fig. 5)."""
+    coloured by MTF50 on ``axis`` (:data:`benchmark.experiments.spm.MTF50_AXES`; paper Fig. 5)."""
     import seaborn as sns
 
-    order = table.groupby("camera")["mtf50_cy_per_mm"].first().sort_values(kind="stable")
-    labels = {c: f"{c} ({m:.0f} cy/mm)" if np.isfinite(m) else c for c, m in order.items()}
+    column, _, unit = spm.MTF50_AXES[axis]
+    order = table.groupby("camera")[column].first().sort_values(kind="stable")
+    digits = ".0f" if axis == "sensor" else ".2f"
+    labels = {c: f"{c} ({m:{digits}} {unit})" if np.isfinite(m) else c for c, m in order.items()}
     data = table.assign(camera=table["camera"].map(labels))
     conditions = list(dict.fromkeys(table["condition"]))
     fig, axes = plt.subplots(1, len(conditions), figsize=(5.0 * len(conditions) + 1.6, 3.8), squeeze=False,
@@ -119,6 +208,9 @@ def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
     rows = od50.set_index(["camera", "condition"])
     out = pd.DataFrame({
         "MTF50 (cy/mm)": rows["mtf50_cy_per_mm"].map(lambda v: f"{v:.1f}" if np.isfinite(v) else "–"),
+        "MTF50 (cy/mrad)": [_fmt(v, ".3f") for v in _col(rows, "mtf50_cy_per_mrad", np.nan)],
+        "focal length (mm)": [_fmt(v, "g") for v in _col(rows, "focal_length_mm", np.nan)],
+        "FOV (°)": _col(rows, "fov_deg", "–"),
         "OD50 ± SD (m)": [_pm(o, s, c, b) for o, s, c, b in zip(rows["od50_m"], rows["sd_m"], _col(rows, "censored", ""),
                                                                 _col(rows, "bound_m", np.nan))],
         "95 % interval (m)": [_interval(lo, hi) if not c else "–" for lo, hi, c in zip(
@@ -188,10 +280,14 @@ def image_strips(runs: dict[tuple[str, str], Path], table: pd.DataFrame) -> list
 
 
 def report(results_dir, out=None) -> Path:
-    """Write ``report.html`` (default: in ``results_dir``) and its figures; returns the page's path."""
-    results_dir = Path(results_dir)
-    table, od50, runs, meta = load_results(results_dir)
-    out = Path(out) if out is not None else results_dir / "report.html"
+    """Write ``report.html`` and its figures; returns the page's path. ``results_dir``: a
+    sweep or run folder (the page goes there by default), or a list of them (:func:`load_many`;
+    ``out`` required)."""
+    folders = [Path(p) for p in results_dir] if isinstance(results_dir, (list, tuple)) else [Path(results_dir)]
+    if out is None and len(folders) > 1:
+        raise ValueError(f"{len(folders)} results folders: name the page with --out (e.g. --out report/report.html)")
+    table, od50, runs, meta = load_many(folders)
+    out = Path(out) if out is not None else folders[0] / "report.html"
     fig_dir = out.parent / "figures"
     is_lux = table["condition"].map(parse_illuminance_condition).notna()
     main, main_od50 = table[~is_lux], od50[~od50["condition"].map(parse_illuminance_condition).notna()]
@@ -224,22 +320,28 @@ def report(results_dir, out=None) -> Path:
 
 
 def _main_figures(table: pd.DataFrame, od50: pd.DataFrame, fig_dir: Path) -> list[tuple]:
-    """(title, caption, figure) of the curves, the MTF50 SPMs and OD50 vs MTF50 (where defined)."""
-    figures = [("AP vs distance", "COCO AP@[.5:.95] for the car at each distance; one line per camera, coloured by "
-                "MTF50; the dotted line is AP 0.5 (OD50).", plot_ap_curves(table, fig_dir / "ap_vs_distance"))]
-    per_condition = table.groupby("condition")["mtf50_cy_per_mm"].nunique()
-    if table["mtf50_cy_per_mm"].notna().all() and (per_condition >= 2).all():
-        mark = 100.0 if table["mtf50_cy_per_mm"].min() <= 100 <= table["mtf50_cy_per_mm"].max() else None
+    """(title, caption, figure) of the curves, the MTF50 SPMs and OD50 vs MTF50 (where defined),
+    on the MTF50 axis :func:`benchmark.experiments.spm.mtf50_axis` picks (named in each caption)."""
+    axis = spm.mtf50_axis(table)
+    column, _, unit = spm.MTF50_AXES[axis]
+    why = spm.mtf50_axis_text(table, axis)
+    figures = [("AP vs distance", f"COCO AP@[.5:.95] for the car at each distance; one line per camera, coloured by "
+                f"MTF50 ({unit}); the dotted line is AP 0.5 (OD50). {why}.",
+                plot_ap_curves(table, fig_dir / "ap_vs_distance", axis=axis))]
+    per_condition = table.groupby("condition")[column].nunique()
+    if table[column].notna().all() and (per_condition >= 2).all():
+        mark = 100.0 if axis == "sensor" and table[column].min() <= 100 <= table[column].max() else None
+        guide = "; dashed: OD50 at MTF50 100 cy/mm" if mark is not None else ""
         figures.append(("System Performance Maps", "AP over (distance, MTF50), linearly interpolated between the "
-                        "measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5; dashed: OD50 at "
-                        "MTF50 100 cy/mm.", spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark)))
-    if od50["camera"].nunique() >= 2 and od50["mtf50_cy_per_mm"].notna().all():
+                        f"measured points (white); iso-AP lines every 0.1, the bold one is AP 0.5{guide}. {why}.",
+                        spm.spm_mtf50(table, fig_dir / "spm_mtf50", mark_mtf50=mark, axis=axis)))
+    if od50["camera"].nunique() >= 2 and od50[column].notna().all():
         measured = (float(table["distance_m"].min()), float(table["distance_m"].max()))
         figures.append(("OD50 vs MTF50", "OD50 with its 95 % bootstrap interval over environments; least-squares "
                         "line per condition through the OD50s inside the measured distances, its slope in the "
                         "legend; hollow triangles: OD50 beyond the measured distances, drawn at the bound (▲ \u2018> farthest\u2019: a "
-                        "lower bound; ▼ \u2018< nearest\u2019), not fitted.",
-                        spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50", measured_range_m=measured)))
+                        f"lower bound; ▼ \u2018< nearest\u2019), not fitted. {why}.",
+                        spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50", measured_range_m=measured, axis=axis)))
     return figures
 
 
@@ -268,9 +370,12 @@ def _page(meta: dict, body: str) -> str:
 
 
 def _run_mtf50(cam: CameraRecord) -> tuple[float, str]:
-    """MTF50 of a run's camera from the spec recorded in its results.json (NaN, "none":
-    no spec, or no source gave one)."""
+    """MTF50 of a run's camera as its results.json records it, else from the spec recorded
+    there (NaN, "none": no spec, or no source gave one)."""
     from benchmark.camera import camera_from_dict
+
+    if cam.mtf50_cy_per_mm is not None:
+        return float(cam.mtf50_cy_per_mm), cam.mtf50_source or "measured"
 
     spec = json.loads(json.dumps(cam.spec or {}))
     spec.get("sensor", {}).pop("width_px", None), spec.get("sensor", {}).pop("height_px", None)  # computed fields
@@ -295,6 +400,10 @@ def _fig_base64(fig) -> str:
 
 def _num(value) -> float:
     return float("nan") if value is None else float(value)
+
+
+def _fmt(value, spec: str) -> str:
+    return format(float(value), spec) if value is not None and np.isfinite(float(value)) else "–"
 
 
 def _col(rows: pd.DataFrame, name: str, default) -> list:

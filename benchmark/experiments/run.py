@@ -36,11 +36,16 @@ from pathlib import Path
 
 import numpy as np
 
+from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
     RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
     write_results,
 )
 
+# How the collection's layers are composited for a camera (metricscenes.store.Collection.radiance):
+# "car" since session 12, the inset at its own resolution only around the car. Runs made before
+# it recorded none, so a sweep does not take them for this composite's.
+COMPOSITE = "car"
 AP_SCORE_THRESHOLD = 0.001  # COCO evaluation wants the whole precision-recall curve
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.
@@ -108,7 +113,7 @@ def capture_key(camera, condition: str, collection, seed: int) -> dict:
     collection manifest sha256, seed, and the camera's geometry and the collection subset
     where present (the detector is not part of it)."""
     key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
-           "manifest_sha256": collection.manifest_sha256, "seed": int(seed)}
+           "manifest_sha256": collection.manifest_sha256, "seed": int(seed), "composite": COMPOSITE}
     geometry = camera_geometry(collection, camera)
     if geometry is not None:
         key["camera_geometry"] = geometry
@@ -121,7 +126,8 @@ def capture_key(camera, condition: str, collection, seed: int) -> dict:
 def results_capture_key(results: RunResults) -> dict:
     """The :func:`capture_key` a ``results.json`` was made with."""
     key = {"camera_spec_sha256": results.camera.spec_sha256, "condition": results.condition,
-           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed}
+           "manifest_sha256": results.collection.manifest_sha256, "seed": results.seed,
+           "composite": results.composite}
     if results.camera_geometry is not None:
         key["camera_geometry"] = results.camera_geometry.model_dump()
     if results.subset is not None:
@@ -174,8 +180,24 @@ def _compact(values) -> str:
     return ", ".join(parts)
 
 
+def _gaps(lo: int, hi: int, known: list[int]) -> list[str]:
+    """The ids of lo..hi that are not in ``known`` (sorted), as ranges ("3-999999999"),
+    without listing them one by one: a range may be as large as its user typed."""
+    gaps, start = [], lo
+    for k in (k for k in known if lo <= k <= hi):
+        if k > start:
+            gaps.append(f"{start}" if k - 1 == start else f"{start}-{k - 1}")
+        start = k + 1
+    if start <= hi:
+        gaps.append(f"{start}" if start == hi else f"{start}-{hi}")
+    return gaps
+
+
 def _parse_environments(text: str, known: list[int]) -> list[int]:
+    """The ids ``text`` names ("0-2,5"), each range bounded by the collection's ids before
+    anything is listed (``0-999999999`` is refused in one line, not expanded)."""
     chosen: set[int] = set()
+    unknown: list[str] = []
     for token in (t.strip() for t in str(text).split(",")):
         try:
             lo, _, hi = token.partition("-")
@@ -185,10 +207,12 @@ def _parse_environments(text: str, known: list[int]) -> list[int]:
                              "(e.g. --environments 0-2,5)") from None
         if hi_i < lo_i:
             raise ValueError(f"--environments: empty range {token!r}")
-        chosen.update(range(lo_i, hi_i + 1))
-    unknown = sorted(chosen - set(known))
+        chosen.update(k for k in known if lo_i <= k <= hi_i)
+        unknown += _gaps(lo_i, hi_i, known)
+    unknown = list(dict.fromkeys(unknown))
     if unknown:
-        raise ValueError(f"--environments: unknown environment id(s) {_compact(unknown)} "
+        shown = ", ".join(unknown[:5]) + (", ..." if len(unknown) > 5 else "")
+        raise ValueError(f"--environments {text}: unknown environment id(s) {shown} "
                          f"(this collection has {_compact(known)})")
     return sorted(chosen)
 
@@ -301,9 +325,13 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
 
     Everything is written to a staging folder inside ``out_dir`` first and moved into place
     only when the run succeeded: a damaged scene or a broken model met halfway leaves
-    ``out_dir`` as it was (the folders the run created are removed).
+    ``out_dir`` as it was (the folders the run created are removed). The run holds
+    ``out_dir/benchmark.lock`` (:func:`metricscenes.lock.output_lock`) throughout, so a second
+    run on the same folder is refused (:class:`~metricscenes.lock.LockError`), and removes the
+    staging folders that killed runs left there.
     """
     from benchmark.camera.pipeline import camera_window
+    from metricscenes.lock import output_lock
 
     out_dir = check_out_dir(out_dir)  # before anything is written
     field = collection_field(collection)
@@ -311,28 +339,50 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     captured = None if captures is None else read_captures(captures, camera, condition, collection, seed)
     created = [p for p in (out_dir, *out_dir.parents) if not p.exists()]
     out_dir.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out_dir))
     try:
-        results = _run_camera(collection, camera, condition, detector, stage, field, window, seed=seed,
-                              save_images=save_images, backend=backend, progress=progress,
-                              captures=None if captures is None else (Path(captures), captured))
-        # Into place, one rename a file: images, detections and ground truth, then
-        # results.json last (a sweep takes a run folder with its results.json as finished).
-        if save_images:
-            (out_dir / "images").mkdir(exist_ok=True)
-            for image in sorted((stage / "images").iterdir()):
-                os.replace(image, out_dir / "images" / image.name)
-        for name in ("detections.json", "groundtruth.json", "results.json"):
-            os.replace(stage / name, out_dir / name)
+        with output_lock(out_dir, "benchmark run", "run folder"):
+            remove_stale_stages(out_dir)
+            return _staged(out_dir, lambda stage: _run_camera(
+                collection, camera, condition, detector, stage, field, window, seed=seed, save_images=save_images,
+                backend=backend, progress=progress, captures=None if captures is None else (Path(captures), captured)),
+                save_images)
     except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
         for folder in created:  # the folders this run made, innermost first, if still empty
             try:
                 folder.rmdir()
             except OSError:
                 break
         raise
-    shutil.rmtree(stage, ignore_errors=True)
+
+
+STAGE_PREFIX = ".partial-"
+
+
+def remove_stale_stages(out_dir: Path) -> list[Path]:
+    """Remove the staging folders (``.partial-*``) that runs killed in ``out_dir`` left
+    behind; the caller holds the folder's lock, so none is in use. Returns them."""
+    stale = sorted(p for p in out_dir.glob(f"{STAGE_PREFIX}*") if p.is_dir() and not p.is_symlink())
+    for folder in stale:
+        shutil.rmtree(folder, ignore_errors=True)
+    return stale
+
+
+def _staged(out_dir: Path, work, save_images: bool) -> RunResults:
+    """``work(stage)`` in a fresh staging folder inside ``out_dir``, its outputs then moved
+    into place one rename a file: images, detections and ground truth, then results.json
+    last (a sweep takes a run folder with its results.json as finished). The stage is
+    removed however it ends."""
+    stage = Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=out_dir))
+    try:
+        results = work(stage)
+        if save_images:
+            (out_dir / "images").mkdir(exist_ok=True)
+            for image in sorted((stage / "images").iterdir()):
+                os.replace(image, out_dir / "images" / image.name)
+        for name in ("detections.json", "groundtruth.json", "results.json"):
+            os.replace(stage / name, out_dir / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
     return results
 
 
@@ -356,10 +406,14 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     detections: list[dict] = []
     exposures: dict[str, float] = {}
     short_exposures: dict[str, float] = {}  # the hdr policy's second frame
+    targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
     for i, scene in enumerate(scenes):
+        record = collection.condition_record(scene.scene_id, condition)
+        if record is not None:
+            targeted[scene.scene_id] = record
         if captures is None:
             t = time.perf_counter()
-            radiance = collection.radiance(scene.scene_id, condition)
+            radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
             timings.add("read_radiance", t)
             t = time.perf_counter()
             capture = simulate(radiance, camera, seed=scene_seed(seed, scene.image_id))
@@ -413,9 +467,9 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     results = RunResults(
         format=RESULTS_FORMAT,
         package_version=__version__,
-        camera=CameraRecord(name=camera.name, pixel_um=camera.pixel_um, f_number=camera.f_number,
-                            width_px=camera.width_px, height_px=camera.height_px, spec_sha256=camera.sha256(),
-                            spec=camera.model_dump(mode="json")),
+        numerics=numeric_provenance(),
+        composite=COMPOSITE,
+        camera=camera_record(camera),
         condition=condition,
         detector=detector_record,
         collection=CollectionRecord(name=collection.name, protocol=collection.protocol,
@@ -431,6 +485,8 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     )
     # The optional fields are set only where they apply, so that other results keep their bytes
     # (results.json holds the fields set: benchmark.result_files).
+    if targeted:
+        results.condition_weights = targeted
     if geometry is not None:  # a camera that sees a window of the field
         results.camera_geometry = CameraGeometry(**geometry)
     subset = getattr(collection, "subset", None)
@@ -444,6 +500,24 @@ def _run_camera(collection, camera, condition: str, detector, stage: Path, field
     (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
     write_results(stage / "results.json", results)
     return results
+
+
+def camera_record(camera) -> CameraRecord:
+    """results.json's ``camera``: name, headline numbers, focal length and field of view,
+    MTF50 on the sensor (cycles/mm, :func:`benchmark.measure.mtf.camera_mtf50`) and in object
+    space (cycles/mrad: × focal length / 1000, what compares cameras of different focal
+    lengths), the spec sha256 and the spec."""
+    from benchmark.measure.mtf import camera_mtf50
+
+    mtf50, source = camera_mtf50(camera)
+    angular = camera.cy_per_mrad(mtf50)
+    return CameraRecord(name=camera.name, pixel_um=camera.pixel_um, f_number=camera.f_number,
+                        width_px=camera.width_px, height_px=camera.height_px,
+                        focal_length_mm=camera.optics.focal_length_mm,
+                        fov_deg=[round(camera.hfov_deg, 4), round(camera.vfov_deg, 4)],
+                        mtf50_cy_per_mm=None if mtf50 is None else round(mtf50, 2),
+                        mtf50_cy_per_mrad=None if angular is None else round(angular, 4), mtf50_source=source,
+                        spec_sha256=camera.sha256(), spec=camera.model_dump(mode="json"))
 
 
 def _finite_or_none(value: float) -> float | None:

@@ -9,6 +9,13 @@ AP = 0.5 line is the OD50 contour.
 
 Every plotting function returns the :class:`matplotlib.figure.Figure` and, given
 ``out``, writes ``out.png`` and ``out.svg`` (the Agg backend: no display needed).
+
+**Which MTF50.** MTF50 in cycles/mm on the sensor ranks cameras by sharpness only when they
+share a focal length (the paper's 13 do: 4.38 mm). Across focal lengths the comparable
+figure is the angular one, cycles/mrad in object space (MTF50 × focal length / 1000): an
+8 mm camera with 168.6 cy/mm resolves 1.35 cy/mrad, finer than cam12's 229.3 cy/mm
+(1.00 cy/mrad). :func:`mtf50_axis` picks the angular axis where the compared cameras'
+focal lengths differ and the sensor-plane one otherwise, and every figure names its axis.
 """
 
 from __future__ import annotations
@@ -24,9 +31,47 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy.interpolate import griddata  # noqa: E402
 
+MTF50_AXES = {
+    "sensor": ("mtf50_cy_per_mm", "MTF50 (cycles/mm on the sensor)", "cy/mm"),
+    "angular": ("mtf50_cy_per_mrad", "MTF50 (cycles/mrad in object space)", "cy/mrad"),
+}
+"""(table column, axis label, unit) of each MTF50 axis."""
 AP_LEVELS = np.linspace(0.0, 1.0, 11)
 ISO_AP_LEVELS = np.round(np.linspace(0.1, 0.9, 9), 2)
 CONDITION_COLOURS = {"day": "tab:orange", "dusk": "tab:purple", "night": "tab:blue"}
+
+
+def focal_lengths_mm(table: pd.DataFrame) -> dict[str, float]:
+    """The focal length of each camera in a sweep or OD50 table (NaN where not recorded)."""
+    if "focal_length_mm" not in table.columns:
+        return {c: float("nan") for c in dict.fromkeys(table["camera"])}
+    return {c: float(v) for c, v in table.groupby("camera", sort=False)["focal_length_mm"].first().items()}
+
+
+def mtf50_axis(table: pd.DataFrame) -> str:
+    """``"angular"`` (cycles/mrad in object space) where the cameras of ``table`` differ in
+    focal length and every one has its angular MTF50, else ``"sensor"`` (cycles/mm: the
+    paper's axis, which orders cameras of one focal length as the angular one would)."""
+    focal = np.array(list(focal_lengths_mm(table).values()), dtype=float)
+    if focal.size < 2 or not np.isfinite(focal).all() or np.ptp(focal) <= 1e-9 * focal.max():
+        return "sensor"
+    column = MTF50_AXES["angular"][0]
+    if column not in table.columns or not np.isfinite(table[column].astype(float)).all():
+        return "sensor"
+    return "angular"
+
+
+def mtf50_axis_text(table: pd.DataFrame, axis: str) -> str:
+    """Why the figures use ``axis``, for a caption: "MTF50 in cycles/mrad in object space
+    (MTF50 × focal length / 1000): the focal lengths differ (4.38, 8 mm)"."""
+    focal = sorted({round(v, 3) for v in focal_lengths_mm(table).values() if np.isfinite(v)})
+    lengths = ", ".join(f"{v:g}" for v in focal)
+    if axis == "angular":
+        return (f"MTF50 in cycles/mrad in object space (MTF50 × focal length / 1000): the cameras' focal lengths "
+                f"differ ({lengths} mm), and on the sensor (cycles/mm) a longer lens would look less sharp than it is")
+    if len(focal) == 1:
+        return f"MTF50 in cycles/mm on the sensor: every camera has the same {lengths} mm focal length"
+    return "MTF50 in cycles/mm on the sensor"
 
 
 def save_figure(fig, out) -> list[Path]:
@@ -99,13 +144,16 @@ def _mark_od50(ax, gx, gy, gz, y_value: float) -> float | None:
 
 
 def spm_mtf50(table: pd.DataFrame, out=None, *, conditions=None, mark_mtf50: float | None = None,
-              title: str | None = None):
+              title: str | None = None, axis: str = "sensor"):
     """SPM of AP over (distance, camera MTF50), one panel per condition.
 
-    ``table``: the sweep table (columns ``condition, mtf50_cy_per_mm, distance_m, ap``).
-    ``mark_mtf50`` draws the dashed OD50 guide at that MTF50 (the paper uses 100 cy/mm).
+    ``table``: the sweep table (columns ``condition, mtf50_cy_per_mm, distance_m, ap``, and
+    ``mtf50_cy_per_mrad`` for ``axis="angular"``). ``axis``: :data:`MTF50_AXES` (see
+    :func:`mtf50_axis`). ``mark_mtf50`` draws the dashed OD50 guide at that MTF50, in the
+    axis' unit (the paper uses 100 cy/mm).
     """
-    _require(table, ("condition", "mtf50_cy_per_mm", "distance_m", "ap"))
+    column, label, _ = MTF50_AXES[axis]
+    _require(table, ("condition", column, "distance_m", "ap"))
     conditions = list(conditions) if conditions is not None else list(dict.fromkeys(table["condition"]))
     fig, axes = plt.subplots(1, len(conditions), figsize=(5.2 * len(conditions), 4.2), squeeze=False,
                              constrained_layout=True)
@@ -114,11 +162,11 @@ def spm_mtf50(table: pd.DataFrame, out=None, *, conditions=None, mark_mtf50: flo
         part = table[table["condition"] == condition]
         if part.empty:
             raise ValueError(f"condition {condition!r} is not in the table (has: {', '.join(map(str, table['condition'].unique()))})")
-        gx, gy, gz = interpolate_map(part["distance_m"], part["mtf50_cy_per_mm"], part["ap"])
-        filled = _draw_map(ax, gx, gy, gz, part["distance_m"], part["mtf50_cy_per_mm"])
+        gx, gy, gz = interpolate_map(part["distance_m"], part[column], part["ap"])
+        filled = _draw_map(ax, gx, gy, gz, part["distance_m"], part[column])
         if mark_mtf50 is not None and _mark_od50(ax, gx, gy, gz, mark_mtf50) is not None:
             ax.legend(loc="upper right", fontsize=7)
-        ax.set(title=f"{condition}", xlabel="distance (m)", ylabel="MTF50 (cycles/mm)")
+        ax.set(title=f"{condition}", xlabel="distance (m)", ylabel=label)
     fig.colorbar(filled, ax=axes[0].tolist(), label="AP (COCO @[.5:.95], car)")
     if title:
         fig.suptitle(title)
@@ -159,9 +207,10 @@ def fit_line(x, y) -> tuple[float, float]:
 
 
 def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title: str | None = None,
-                  measured_range_m: tuple[float, float] | None = None):
-    """OD50 against MTF50, per condition, with a fitted line whose slope (m per cycle/mm)
-    is in the legend (paper Fig. 7A). Error bars are the 95 % bootstrap interval when the
+                  measured_range_m: tuple[float, float] | None = None, axis: str = "sensor"):
+    """OD50 against MTF50, per condition, with a fitted line whose slope (m per cycle/mm, or
+    per cycle/mrad on the ``angular`` axis: :data:`MTF50_AXES`, :func:`mtf50_axis`) is in the
+    legend (paper Fig. 7A). Error bars are the 95 % bootstrap interval when the
     table has it (``ci95_lo_m``, ``ci95_hi_m``): OD50 extrapolated beyond the measured
     distances has a skewed, unbounded spread that a symmetric ± SD bar misdraws (below
     0 m); an unbounded upper end is drawn to the top of the axes. Otherwise ± SD.
@@ -175,8 +224,12 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     ``bound_m`` columns (:func:`benchmark.experiments.sweep.with_censoring`, as the report passes) the
     censored OD50s are drawn as hollow triangles at their bound instead — ▲ at the farthest
     distance ("> 200 m", a lower bound), ▼ at the nearest ("< 25 m") — and the legend says so.
+
+    The OD50 axis is scaled to what is drawn (:func:`_axis_top_m`): the fitted OD50s, the
+    bounds and the measured distances, never the extrapolated number behind a bound.
     """
-    _require(od50_table, ("condition", "mtf50_cy_per_mm", "od50_m", "sd_m"))
+    x, x_label, x_unit = MTF50_AXES[axis]
+    _require(od50_table, ("condition", x, "od50_m", "sd_m"))
     conditions = list(conditions) if conditions is not None else list(dict.fromkeys(od50_table["condition"]))
     lo_m, hi_m = measured_range_m if measured_range_m is not None else (-np.inf, np.inf)
     finite = od50_table.assign(od50_m=od50_table["od50_m"].astype(float))
@@ -188,14 +241,15 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     else:
         finite = finite.assign(fitted=finite["od50_m"].between(lo_m, hi_m))
     inside = finite[finite["fitted"]]
-    top = max(_axis_top(inside if len(inside) else finite), 1.1 * hi_m if np.isfinite(hi_m) else 0.0)
+    bounds = finite.loc[~finite["fitted"], "bound_m"] if censored else pd.Series(dtype=float)
+    top = _axis_top_m(finite, inside, bounds, hi_m)
     fig, ax = plt.subplots(figsize=(5.6, 4.2), constrained_layout=True)
     for k, condition in enumerate(conditions):
         part = finite[finite["condition"] == condition]
         fitted, outside = part[part["fitted"]], part[~part["fitted"]]
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
-        slope, intercept = fit_line(fitted["mtf50_cy_per_mm"], fitted["od50_m"])
-        label = f"{condition}: slope {slope:.2f} m per cy/mm" if np.isfinite(slope) else f"{condition}: no fit"
+        slope, intercept = fit_line(fitted[x], fitted["od50_m"])
+        label = f"{condition}: slope {slope:.2f} m per {x_unit}" if np.isfinite(slope) else f"{condition}: no fit"
         if len(outside) and censored:
             label += f" ({_bounds_text(outside)}: hollow, not fitted)"
         elif len(outside):
@@ -204,19 +258,19 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
             for sign, marker in ((">", "^"), ("<", "v")):
                 pts = outside[outside["censored"] == sign]
                 if len(pts):
-                    ax.plot(pts["mtf50_cy_per_mm"], np.minimum(pts["bound_m"].astype(float), top), marker, ms=8,
+                    ax.plot(pts[x], np.minimum(pts["bound_m"].astype(float), top), marker, ms=8,
                             mfc="none", color=colour, alpha=0.9, ls="none")
             outside = outside.iloc[0:0]
         # filled (and labelled) even when empty, so every condition has its legend entry
         for points, style in ((fitted, {"label": label}), (outside, {"mfc": "none", "alpha": 0.8})):
             if len(points) or "label" in style:
-                ax.errorbar(points["mtf50_cy_per_mm"], np.minimum(points["od50_m"], top),
+                ax.errorbar(points[x], np.minimum(points["od50_m"], top),
                             yerr=_error_bars(points, top), fmt="o", color=colour, capsize=3, **style)
         if np.isfinite(slope):
-            xs = np.linspace(fitted["mtf50_cy_per_mm"].min(), fitted["mtf50_cy_per_mm"].max(), 2)
+            xs = np.linspace(fitted[x].min(), fitted[x].max(), 2)
             ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
     interval = {"ci95_lo_m", "ci95_hi_m"} <= set(od50_table.columns)
-    ax.set(xlabel="MTF50 (cycles/mm)", ylabel="OD50 (m)", ylim=(0, top),
+    ax.set(xlabel=x_label, ylabel="OD50 (m)", ylim=(0, top),
            title=title or ("OD50 vs MTF50 (95 % bootstrap interval)" if interval else "OD50 vs MTF50 (± bootstrap SD)"))
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
@@ -239,6 +293,20 @@ def _axis_top(table: pd.DataFrame) -> float:
     finite = table["od50_m"].astype(float)
     finite = finite[np.isfinite(finite)]
     return 1.6 * float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+
+
+def _axis_top_m(finite: pd.DataFrame, fitted: pd.DataFrame, bounds: pd.Series, farthest_m: float) -> float:
+    """Top of the OD50 axis, m, from what the plot draws at its value: 1.6 × the largest
+    fitted OD50, 1.15 × the largest censored bound (its ▲ stays inside), 1.1 × the farthest
+    measured distance. An OD50 extrapolated behind a bound ("> 200 m" whose number is 1300 m)
+    never sets the scale; with no fitted point, bound or measured range known, every point
+    is drawn at its value and sets it."""
+    tops = [_axis_top(fitted)] if len(fitted) else []
+    bounds = bounds.astype(float)
+    tops += [1.15 * float(b) for b in bounds[np.isfinite(bounds)]]
+    if np.isfinite(farthest_m):
+        tops.append(1.1 * farthest_m)
+    return max(tops) if tops else _axis_top(finite)
 
 
 def _error_bars(part: pd.DataFrame, top: float) -> np.ndarray:

@@ -18,8 +18,8 @@ Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7), their schemas in :mod:`ben
 
 - ``sweep.csv`` / ``sweep.json``: one row per camera × condition × distance with
   ``camera, pixel_um, f_number, mtf50_cy_per_mm, mtf50_source, condition, distance_m,
-  ap, ap50, n_images`` (:class:`~benchmark.result_files.SweepRow`; sweep.json:
-  :class:`~benchmark.result_files.SweepRecord`);
+  ap, ap50, n_images, focal_length_mm, mtf50_cy_per_mrad`` (:class:`~benchmark.result_files.SweepRow`;
+  sweep.json: :class:`~benchmark.result_files.SweepRecord`);
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
   environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`;
   :class:`~benchmark.result_files.Od50Row`).
@@ -207,6 +207,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.camera import load_camera
     from benchmark.camera.exposure import exposure_tag, format_exposure, with_exposure
     from metricscenes.backends import check_scheduler, map_units, runs_in_process
+    from metricscenes.lock import output_lock
     from metricscenes.store import Collection
 
     if mtf_source not in MTF50_SOURCES:
@@ -227,7 +228,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     known = list(collection.condition_names)  # with the illuminance sweep's
     for condition in conditions:
         if condition not in known:
-            raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(known)})")
+            from benchmark.suggest import did_you_mean
+
+            raise ValueError(f"unknown condition {condition!r} (this collection has: {', '.join(known)})"
+                             f"{did_you_mean(condition, known)}")
     names = [c.name for c in cameras]
     if len(set(names)) != len(names):
         raise ValueError(f"camera names must be unique, got {names}")
@@ -240,85 +244,88 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     out_dir = run_module.check_out_dir(out_dir)
     if captures_from is not None and Path(captures_from).resolve() == out_dir.resolve():
         raise ValueError(f"--captures-from {captures_from} is the sweep folder itself: name another sweep's folder")
-    (out_dir / "runs").mkdir(parents=True, exist_ok=True)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with output_lock(out_dir, "benchmark sweep", "sweep folder"):  # one sweep writes a folder at a time
+        (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
-    n_scenes = len(collection.scenes())
-    total, done = n_scenes * len(cameras) * len(conditions), 0
-    run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
-                for camera in cameras for condition in conditions}
-    results: dict[tuple[str, str], RunResults] = {}
-    todo = []
-    for camera in cameras:
-        for condition in conditions:
-            cached = cached_results(run_dirs[camera.name, condition], run_key(camera, condition, detector, collection, seed))
-            if cached is None:
-                todo.append((camera, condition))
-                continue
-            results[camera.name, condition] = cached
-            done += n_scenes
-            if progress:
-                progress(done, total, f"{camera.name} · {condition}")
-    reused = set(results)
+        n_scenes = len(collection.scenes())
+        total, done = n_scenes * len(cameras) * len(conditions), 0
+        run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
+                    for camera in cameras for condition in conditions}
+        results: dict[tuple[str, str], RunResults] = {}
+        todo = []
+        for camera in cameras:
+            for condition in conditions:
+                cached = cached_results(run_dirs[camera.name, condition], run_key(camera, condition, detector, collection, seed))
+                if cached is None:
+                    todo.append((camera, condition))
+                    continue
+                results[camera.name, condition] = cached
+                done += n_scenes
+                if progress:
+                    progress(done, total, f"{camera.name} · {condition}")
+        reused = set(results)
 
-    in_process = runs_in_process(workers, scheduler)
+        in_process = runs_in_process(workers, scheduler)
 
-    def scene_progress(label: str):
-        # (a run computed here reports each scene; ``done`` is read when called: the runs before it)
-        return (lambda d, t: progress(done + d, total, label)) if progress and in_process else None
+        def scene_progress(label: str):
+            # (a run computed here reports each scene; ``done`` is read when called: the runs before it)
+            return (lambda d, t: progress(done + d, total, label)) if progress and in_process else None
 
-    def captures(camera, condition: str) -> Path | None:
-        if captures_from is None:
-            return None
-        return captures_for(Path(captures_from) / run_dirs[camera.name, condition].relative_to(out_dir),
-                            camera, condition, collection, seed)
+        def captures(camera, condition: str) -> Path | None:
+            if captures_from is None:
+                return None
+            return captures_for(Path(captures_from) / run_dirs[camera.name, condition].relative_to(out_dir),
+                                camera, condition, collection, seed)
 
-    jobs = [(collection, camera, condition, detector, run_dirs[camera.name, condition], seed, save_images, backend,
-             n_resamples, scene_progress(f"{camera.name} · {condition}"), captures(camera, condition))
-            for camera, condition in todo]
-    with closing(map_units(compute_run, jobs, workers=workers, scheduler=scheduler)) as finished:
-        for camera_name, condition, run_results in finished:  # in the order they finish
-            results[camera_name, condition] = run_results
-            done += n_scenes
-            if progress:
-                progress(done, total, f"{camera_name} · {condition}")
+        jobs = [(collection, camera, condition, detector, run_dirs[camera.name, condition], seed, save_images, backend,
+                 n_resamples, scene_progress(f"{camera.name} · {condition}"), captures(camera, condition))
+                for camera, condition in todo]
+        with closing(map_units(compute_run, jobs, workers=workers, scheduler=scheduler)) as finished:
+            for camera_name, condition, run_results in finished:  # in the order they finish
+                results[camera_name, condition] = run_results
+                done += n_scenes
+                if progress:
+                    progress(done, total, f"{camera_name} · {condition}")
 
-    rows, od50_rows, runs = [], [], []
-    for camera in cameras:
-        mtf50, source = camera_mtf50(camera, mtf_source)
-        ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
-                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source}  # mtf50 None: NaN in the tables
-        for condition in conditions:
-            run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
-            runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
-                                 reused=(camera.name, condition) in reused))
-            for r in run_results.per_distance:
-                rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
-                                     n_images=r.n_images))
-            boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
-            lo, hi = boot.ci95_m
-            od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
-                                     ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
-                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
+        rows, od50_rows, runs = [], [], []
+        for camera in cameras:
+            mtf50, source = camera_mtf50(camera, mtf_source)
+            ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
+                     "mtf50_cy_per_mm": mtf50, "mtf50_source": source,  # mtf50 None: NaN in the tables
+                     "focal_length_mm": camera.optics.focal_length_mm, "mtf50_cy_per_mrad": camera.cy_per_mrad(mtf50)}
+            for condition in conditions:
+                run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
+                runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
+                                     reused=(camera.name, condition) in reused))
+                for r in run_results.per_distance:
+                    rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
+                                         n_images=r.n_images))
+                boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
+                lo, hi = boot.ci95_m
+                od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
+                                         ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
+                                         n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
 
-    table = write_sweep_table(out_dir / "sweep.csv", rows)
-    od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
-    record = SweepRecord(
-        format=SWEEP_FORMAT,
-        collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
-                                    path=str(collection.root)),
-        detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
-        seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
-        cameras=names, conditions=conditions, runs=runs,
-        # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
-        table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
-    )
-    if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
-        record.subset = Subset(**subset)
-    if exposure is not None:  # only then, so that other sweeps keep their bytes
-        record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
-                                        spec=exposure.model_dump(mode="json"))
-    write_sweep_record(out_dir / "sweep.json", record)
-    return table
+        table = write_sweep_table(out_dir / "sweep.csv", rows)
+        od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
+        record = SweepRecord(
+            format=SWEEP_FORMAT,
+            collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
+                                        path=str(collection.root)),
+            detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
+            seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
+            cameras=names, conditions=conditions, runs=runs,
+            # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
+            table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
+        )
+        if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
+            record.subset = Subset(**subset)
+        if exposure is not None:  # only then, so that other sweeps keep their bytes
+            record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
+                                            spec=exposure.model_dump(mode="json"))
+        write_sweep_record(out_dir / "sweep.json", record)
+        return table
 
 
 def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:

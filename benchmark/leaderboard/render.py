@@ -24,7 +24,7 @@ from importlib import resources
 from pathlib import Path
 
 from benchmark.leaderboard.protocols import Protocol, load_protocols
-from benchmark.leaderboard.validate import SUBMISSIONS, read_submission_file, validate_submission
+from benchmark.leaderboard.validate import SUBMISSIONS, duplicate_problem, read_submission_file, validate_submission
 from metricscenes.files import write_atomic
 
 REPRODUCE = """\
@@ -42,12 +42,20 @@ class Column:
 
 
 def load_submissions(leaderboard_dir: str | Path, protocols: dict[str, Protocol] | None = None) -> list[dict]:
-    """Every ``submissions/*.json``, validated (first failure raises :class:`SubmissionError`), by name."""
+    """Every ``submissions/*.json``, validated (first failure raises :class:`SubmissionError`), by name;
+    two files of one system (or sharing detections) are refused too: one row per system."""
+    from benchmark.leaderboard.schema import SubmissionError
+
     folder = Path(leaderboard_dir) / SUBMISSIONS
     protocols = load_protocols(leaderboard_dir) if protocols is None else protocols
     out = []
     for path in sorted(folder.glob("*.json")) if folder.is_dir() else []:
-        out.append(validate_submission(read_submission_file(path), protocols=protocols, source=f"{SUBMISSIONS}/{path.name}"))
+        sub = validate_submission(read_submission_file(path), protocols=protocols, source=f"{SUBMISSIONS}/{path.name}")
+        for earlier in out:
+            problem = duplicate_problem(sub, earlier, f"{earlier['name']}.json")
+            if problem:
+                raise SubmissionError(f"{SUBMISSIONS}/{path.name}: {problem}")
+        out.append(sub)
     return out
 
 
@@ -127,23 +135,42 @@ def _num(value, fmt: str) -> tuple[str, str]:
 def columns(protocol: Protocol) -> list[Column]:
     od50 = [Column(f"{c}_od50", f"{c.capitalize()} OD50 (m)", "num") for c in protocol.conditions]
     return [Column("rank", "#", "num"), Column("system", "System", "str"), Column("camera", "Camera", "str"), *od50,
-            Column("mtf50", "MTF50 (cy/mm)", "num"), Column("pixel_um", "Pixel (µm)", "num"),
+            Column("mtf50", "MTF50 (cy/mm)", "num"), Column("mtf50_mrad", "MTF50 (cy/mrad)", "num"),
+            Column("focal_mm", "Focal (mm)", "num"), Column("fov", "FOV (°)", "num"),
+            Column("pixel_um", "Pixel (µm)", "num"),
             Column("f_number", "f-number", "num"), Column("detector", "Detector", "str"),
             Column("submitter", "Submitter", "str"), Column("date", "Date", "str")]  # fmt: skip
 
 
+def camera_geometry(spec: dict) -> tuple[float, float, float]:
+    """(focal length mm, horizontal and vertical field of view in degrees) of a submission's
+    camera spec (the spec's own geometry: distortion included)."""
+    from benchmark.leaderboard.validate import camera_from_dump
+
+    camera = camera_from_dump(spec)
+    return camera.optics.focal_length_mm, camera.hfov_deg, camera.vfov_deg
+
+
 def row_cells(rank: int, sub: dict, protocol: Protocol) -> dict[str, tuple[str, str]]:
-    """``{column key: (sort value, text)}`` of one submission."""
+    """``{column key: (sort value, text)}`` of one submission. MTF50 in cycles/mrad (object
+    space: × focal length / 1000), focal length and field of view are derived from the
+    submitted spec and MTF50, so every submission shows them."""
+    from benchmark.camera.spec import cy_per_mrad
+
     spec = sub["camera"]["spec"]
     mtf = sub["camera"]["mtf50_cy_per_mm"]
+    focal, hfov, vfov = camera_geometry(spec)
     cells = {"rank": (str(rank), str(rank)), "system": (sub["name"], sub["name"]), "camera": (sub["camera"]["name"],) * 2}
     for c in protocol.conditions:
         cells[f"{c}_od50"] = _fmt_od50(sub["conditions"].get(c))
+    group = " (group)" if sub["camera"]["mtf50_source"] == "published_group" else ""
     mtf_sort, mtf_text = _num(mtf, ".0f")
-    if sub["camera"]["mtf50_source"] == "published_group":
-        mtf_text += " (group)"
+    mrad_sort, mrad_text = _num(cy_per_mrad(mtf, focal), ".2f")
     cells.update({
-        "mtf50": (mtf_sort, mtf_text),
+        "mtf50": (mtf_sort, mtf_text + group),
+        "mtf50_mrad": (mrad_sort, mrad_text + group),
+        "focal_mm": _num(focal, "g"),
+        "fov": (repr(float(hfov)), f"{hfov:.1f} × {vfov:.1f}"),
         "pixel_um": _num(spec["sensor"]["pixel_um"], "g"),
         "f_number": _num(spec["optics"]["f_number"], "g"),
         "detector": (sub["detector"]["name"],) * 2,
@@ -180,9 +207,10 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
         "lower bound; ranked above every measured OD50, ties broken by AP at the farthest distance), \\< 25",
         "when AP is below 0.5 already at the nearest (ranked below every measured OD50, by AP at the nearest",
         "distance); an extrapolated OD50 is neither shown nor ranked by. MTF50 is measured on the camera's",
-        "simulated slanted edge (ISO 12233), or the paper's published group where marked. Open",
-        "[index.html](index.html) for a sortable table; see [docs/leaderboard.md](../docs/leaderboard.md)",
-        "for the submission format and rules.", "",
+        "simulated slanted edge (ISO 12233), or the paper's published group where marked, in cycles/mm on",
+        "the sensor and in cycles/mrad in object space (× focal length / 1000): only the angular figure",
+        "compares cameras whose focal lengths differ. Open [index.html](index.html) for a sortable table;",
+        "see [docs/leaderboard.md](../docs/leaderboard.md) for the submission format and rules.", "",
         f"{len(submissions)} submission(s)" + (f"; newest {latest}." if latest else "."), "",
     ]  # fmt: skip
     for protocol, subs in _by_protocol(submissions, protocols):
@@ -235,7 +263,8 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
         f"± is the bootstrap SD over environments ({esc(_resamples(submissions))}). &gt; 200: AP has not yet fallen "
         "to 0.5 at the farthest distance (a lower bound; ranked above every measured OD50, ties broken by AP at the "
         "farthest distance); &lt; 25: below 0.5 already at the nearest (ranked below every measured OD50, by AP at the "
-        "nearest). Click a column to sort.</p>",
+        "nearest). MTF50 in cycles/mm on the sensor and in cycles/mrad in object space (× focal length / 1000): "
+        "only the angular figure compares cameras whose focal lengths differ. Click a column to sort.</p>",
         f'<p class="meta">{len(submissions)} submission(s)' + (f"; newest {esc(latest)}" if latest else "") + ".</p>",
     ]  # fmt: skip
     for protocol, subs in _by_protocol(submissions, protocols):
@@ -255,11 +284,21 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
             for c in cols:
                 value, text = cells[c.key]
                 body = f'<a href="submissions/{esc(sub["name"])}.json">{esc(text)}</a>' if c.key == "system" else esc(text)
-                tds.append(f'<td data-v="{esc(value)}"{" class=t" if c.kind == "str" else ""}>{body}</td>')
+                tds.append(f'<td data-v="{esc(value)}"{_cell_class(c)}>{body}</td>')
             out.append(f'<tr data-name="{esc(sub["name"])}">' + "".join(tds) + "</tr>")
         out += ["</tbody>", "</table></div>", "</section>"]
     out += [f"<script>{script}</script>", "</body>", "</html>", ""]
     return "\n".join(out)
+
+
+WRAPPED_COLUMNS = ("detector", "submitter")
+"""Columns whose text may wrap (free text, model names); every other cell stays on one line, so that the
+table fits a 1400 px window without scrolling sideways (tests/test_leaderboard_html.py)."""
+
+
+def _cell_class(column: Column) -> str:
+    classes = (["t"] if column.kind == "str" else []) + (["wrap"] if column.key in WRAPPED_COLUMNS else [])
+    return f' class="{" ".join(classes)}"' if len(classes) > 1 else (f" class={classes[0]}" if classes else "")
 
 
 def render_leaderboard(leaderboard_dir: str | Path = "leaderboard") -> tuple[Path, Path]:

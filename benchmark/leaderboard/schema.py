@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import unicodedata
 from functools import lru_cache
 from importlib import resources
 
@@ -91,11 +92,23 @@ _BAD_CHAR = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
 _BAD_CHAR_MULTILINE = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")  # \t and \n allowed
 
 
+def _format_char(text: str) -> str | None:
+    """The first invisible formatting character of ``text`` (Unicode category Cf: the
+    bidirectional overrides, embeddings and isolates that make "21mac" read as "cam12", zero-width
+    spaces and joiners, the byte-order mark), described; None if there is none."""
+    if text.isascii():
+        return None
+    for ch in text:
+        if unicodedata.category(ch) == "Cf":
+            return f"an invisible formatting character U+{ord(ch):04X} ({unicodedata.name(ch, 'unnamed').lower()})"
+    return None
+
+
 def _bad_char(text: str, multiline: bool = False) -> str | None:
     """What is wrong with the first character of ``text`` that has no place in a submission string, if any."""
     found = (_BAD_CHAR_MULTILINE if multiline else _BAD_CHAR).search(text)
     if found is None:
-        return None
+        return _format_char(text)
     code = ord(found.group())
     if 0xD800 <= code <= 0xDFFF:
         return f"a lone surrogate U+{code:04X} (not valid Unicode; UTF-8 cannot encode it)"
@@ -104,8 +117,9 @@ def _bad_char(text: str, multiline: bool = False) -> str | None:
 
 def check_values(data: object, source: str = "submission") -> None:
     """Refuse nesting deeper than :data:`MAX_DEPTH`, numbers that are not finite, and strings
-    (keys too) holding a lone surrogate (UTF-8 cannot encode it), a control character or a
-    line break (``notes`` may hold line breaks and tabs). Iterative, so any depth is refused
+    (keys too) holding a lone surrogate (UTF-8 cannot encode it), a control character, a line
+    break (``notes`` may hold line breaks and tabs) or an invisible formatting character (a
+    right-to-left override: text that reads otherwise than it is). Iterative, so any depth is refused
     with one line, never a RecursionError."""
     stack: list[tuple[tuple, object]] = [((), data)]
     while stack:

@@ -1,15 +1,22 @@
 """Validation of a submission: file, JSON, schema, then what the schema cannot say.
 
 Each refusal is a :class:`SubmissionError` with a one-line reason. The checks beyond the
-schema: no string holds a control character, line break or lone surrogate and no number is
-infinite (:func:`benchmark.leaderboard.schema.check_values`); ``created_at`` is a real date,
-not in the future; the camera spec's sha256 matches its content; the protocol and manifest
-hash are accepted (:mod:`benchmark.leaderboard.protocols`); every condition has exactly the
-protocol's distances, the protocol's number of environments and its own detections file,
-and the required conditions are there; AP never exceeds AP50; OD50 follows from the AP
-curve (:func:`benchmark.scoring.od50`) and lies inside its ordered 95 % interval; the name
-is new on the leaderboard; and, given the detections file and ground truth, AP recomputed
-with :func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
+schema: no string holds a control character, line break, lone surrogate or invisible
+formatting character (a right-to-left override, a zero-width space) and no number is
+infinite (:func:`benchmark.leaderboard.schema.check_values`); no name is blank or padded
+with spaces; ``created_at`` is a real date, not in the future; the camera spec's sha256
+matches its content, and a measured or analytic MTF50 is the one its spec gives; the
+detector is what ``benchmark run`` records (a registry model's name, sha256, family and
+licence together, an input-size policy, AP's score threshold 0.001, multi-label); the
+protocol and manifest hash are accepted (:mod:`benchmark.leaderboard.protocols`); every
+condition has exactly the protocol's distances, one image per environment at each, the
+protocol's number of environments and its own detections file, and the required conditions
+are there; AP never exceeds AP50; OD50 follows from the AP curve
+(:func:`benchmark.scoring.od50`) and lies inside its ordered 95 % interval, whose SD is 0
+only if it has no width; the name is new on the leaderboard, and so are the system (camera
+spec, detector, collection: a reproduction is not a second row) and its detections; and,
+given the detections file and ground truth, AP recomputed with
+:func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
 """
 
 from __future__ import annotations
@@ -26,6 +33,10 @@ from benchmark.leaderboard.schema import SubmissionError, check_schema, check_va
 from metricscenes.files import sha256_file
 
 MAX_SUBMISSION_BYTES = 5 * 1024 * 1024
+MTF50_TOLERANCE = 0.1  # cy/mm: submissions round MTF50 to 0.1 cy/mm (one step of slack: another machine's rounding)
+# Free-text fields that name something: not blank, not padded with spaces (a row that looks like another's)
+NAMED_FIELDS = (("submitter",), ("camera", "name"), ("detector", "name"), ("detector", "family"),
+                ("detector", "licence"), ("collection", "name"), ("package_version",))
 NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
 AP_TOLERANCE = 1e-6
 OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
@@ -127,10 +138,84 @@ def _check_camera(data: dict, source: str) -> None:
     value, kind = cam["mtf50_cy_per_mm"], cam["mtf50_source"]
     if kind == "none" and value is not None:
         raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm must be null when mtf50_source is 'none'")
+    if kind == "none" and spec.mtf50_group_cy_per_mm is not None:
+        raise SubmissionError(f"{source}: camera.mtf50_source is 'none', but the spec has a published MTF50 group "
+                              f"({spec.mtf50_group_cy_per_mm:g} cy/mm)")
     if kind == "published_group" and value != spec.mtf50_group_cy_per_mm:
         raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm {value} is not the spec's published group {spec.mtf50_group_cy_per_mm}")
     if kind in ("measured", "analytic") and value is None:
         raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm is null but mtf50_source is {kind!r}")
+    if kind in ("measured", "analytic"):
+        expected, got = _spec_mtf50(spec, kind)
+        if got != kind or abs(expected - value) > MTF50_TOLERANCE:
+            raise SubmissionError(f"{source}: camera.mtf50_cy_per_mm {value} ({kind}) is not the camera's: its spec "
+                                  f"gives {expected:.1f} cy/mm ({got})")
+
+
+_MTF50_CACHE: dict[tuple[str, str], tuple[float, str]] = {}
+
+
+def _spec_mtf50(spec, kind: str) -> tuple[float, str]:
+    """MTF50 (cy/mm) of a camera spec by the one policy, from ``kind`` on (measured: the
+    simulated slanted edge, 0.1 s), and the source that gave it; cached per spec sha256."""
+    from benchmark.measure.mtf import camera_mtf50
+
+    key = (spec.sha256(), kind)
+    if key not in _MTF50_CACHE:
+        value, got = camera_mtf50(spec, kind)
+        _MTF50_CACHE[key] = (float("nan") if value is None else float(value), got)
+    return _MTF50_CACHE[key]
+
+
+def _check_named_fields(data: dict, source: str) -> None:
+    """No name is blank or starts or ends with white space ("cam12 " would pass for cam12)."""
+    for path in NAMED_FIELDS:
+        value = data
+        for key in path:
+            value = value.get(key) if isinstance(value, dict) else None
+        if isinstance(value, str) and (not value.strip() or value != value.strip()):
+            raise SubmissionError(f"{source}: {'.'.join(path)} {value!r} is blank or padded with white space")
+
+
+def _check_detector(data: dict, source: str) -> None:
+    """The detector as ``benchmark run`` records it: a registry model's name, sha256,
+    family and licence go together (a registry name with another file, or a registry file
+    under another name, is refused); its family is a known one, its input size a policy;
+    AP is scored at threshold 0.001 with multi-label boxes."""
+    from benchmark.detectors import registry
+    from benchmark.detectors.onnx_detector import FAMILIES
+    from benchmark.detectors.policy import parse_input_size
+    from benchmark.experiments.run import AP_SCORE_THRESHOLD
+
+    det = data["detector"]
+    models = registry()
+    by_sha = {m.sha256: m for m in models.values()}
+    entry = models.get(det["name"])
+    if entry is not None and det["sha256"] != entry.sha256:
+        raise SubmissionError(f"{source}: detector.sha256 {det['sha256'][:12]}... is not the sha256 of registry model "
+                              f"{entry.name!r} ({entry.sha256[:12]}...)")
+    entry = entry or by_sha.get(det["sha256"])
+    if entry is not None and det["name"] != entry.name:
+        raise SubmissionError(f"{source}: detector.sha256 {det['sha256'][:12]}... is registry model {entry.name!r}, "
+                              f"but detector.name is {det['name']!r}")
+    if entry is not None:
+        for field in ("family", "licence"):
+            if det[field] != getattr(entry, field):
+                raise SubmissionError(f"{source}: detector.{field} {det[field]!r} is not registry model "
+                                      f"{entry.name!r}'s ({getattr(entry, field)!r})")
+    if det["family"] not in FAMILIES:
+        raise SubmissionError(f"{source}: detector.family {det['family']!r} is not a known family "
+                              f"({', '.join(sorted(FAMILIES))})")
+    try:
+        parse_input_size(det["input_size"])
+    except ValueError as exc:
+        raise SubmissionError(f"{source}: detector.{exc}") from None
+    if det["score_threshold"] != AP_SCORE_THRESHOLD:
+        raise SubmissionError(f"{source}: detector.score_threshold {det['score_threshold']} is not AP's "
+                              f"{AP_SCORE_THRESHOLD} (`benchmark run` keeps every detection down to it)")
+    if det.get("multi_label") is False:
+        raise SubmissionError(f"{source}: detector.multi_label is false; `benchmark run` scores AP with multi-label "
+                              "boxes")
 
 
 def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) -> None:
@@ -149,6 +234,11 @@ def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) ->
     if extra:
         raise SubmissionError(f"{where}: distance {extra[0]:g} m is not one of protocol {protocol.name!r}'s distances")
     rows = sorted(cond["per_distance"], key=lambda r: r["distance_m"])
+    environments = protocol.n_environments if protocol.n_environments is not None else cond["n_environments"]
+    for r in rows:  # the paired design: every environment is placed once at every distance
+        if r["n_images"] != environments:
+            raise SubmissionError(f"{where}: n_images {r['n_images']} at {r['distance_m']:g} m, but a collection of "
+                                  f"{environments} environments has {environments} images at each distance")
     for r in rows:
         if r["ap"] > r["ap50"] + AP_TOLERANCE:
             raise SubmissionError(
@@ -169,9 +259,10 @@ def _check_condition(cname: str, cond: dict, protocol: Protocol, source: str) ->
 
 
 def _check_interval(cname: str, cond: dict, source: str) -> None:
-    """``od50_ci95_m`` = [lo, hi] is ordered (null = +inf). It need not hold ``od50_m``: the
-    percentile ends are order statistics of the bootstrap distribution
-    (:func:`benchmark.scoring.percentile_interval`), which a skewed OD50 may leave outside."""
+    """``od50_ci95_m`` = [lo, hi] is ordered (null = +inf) and holds ``od50_m`` (null =
+    +inf; 1 mm of rounding): an interval that excludes its own estimate says the numbers were
+    not made together. ``od50_sd_m`` is 0 only where the interval has no finite width (the
+    SD is of the finite resampled OD50s; the interval holds the infinite ones too)."""
     def show(v: float) -> str:
         return "null" if v == math.inf else f"{v:g}"
 
@@ -179,6 +270,12 @@ def _check_interval(cname: str, cond: dict, source: str) -> None:
     where = f"{source}: conditions.{cname}"
     if lo > hi:
         raise SubmissionError(f"{where}.od50_ci95_m = [{show(lo)}, {show(hi)}] is reversed (lo > hi)")
+    value = math.inf if cond["od50_m"] is None else float(cond["od50_m"])
+    if not (lo - OD50_TOLERANCE_M <= value <= hi + OD50_TOLERANCE_M):
+        raise SubmissionError(f"{where}.od50_m = {show(value)} lies outside its od50_ci95_m [{show(lo)}, {show(hi)}]")
+    if cond["od50_sd_m"] == 0 and math.isfinite(hi) and hi - lo > OD50_TOLERANCE_M:
+        raise SubmissionError(f"{where}.od50_sd_m = 0, but its od50_ci95_m [{show(lo)}, {show(hi)}] has a width "
+                              "(identical resamples have no spread)")
 
 
 def validate_submission(
@@ -200,7 +297,9 @@ def validate_submission(
     now = datetime.now(timezone.utc) if now is None else now
     if created > now + CLOCK_TOLERANCE:
         raise SubmissionError(f"{source}: created_at {data['created_at']} is in the future (now {now:%Y-%m-%dT%H:%M:%SZ})")
+    _check_named_fields(data, source)
     _check_camera(data, source)
+    _check_detector(data, source)
     protocols = load_protocols() if protocols is None else protocols
     col = data["collection"]
     protocol = protocols.get(col["protocol"])
@@ -235,15 +334,30 @@ def validate_submission(
     return data
 
 
-def _identity(data: dict) -> tuple:
-    return (
-        data["camera"]["spec_sha256"], data["detector"]["sha256"], data["collection"]["manifest_sha256"],
-        tuple(sorted(c["detections_sha256"] for c in data["conditions"].values())),
-    )
+def system_identity(data: dict) -> tuple:
+    """What makes two submissions one camera system: camera spec, detector (file and input
+    size) and collection manifest. Another run of it (another seed, another machine, another
+    name) is a reproduction of that entry, not a second row."""
+    return (data["camera"]["spec_sha256"], data["detector"]["sha256"], str(data["detector"]["input_size"]),
+            data["collection"]["manifest_sha256"])
+
+
+def duplicate_problem(data: dict, other: dict, other_name: str) -> str | None:
+    """Why ``data`` may not stand beside ``other`` (an entry named ``other_name``), or None."""
+    if system_identity(data) == system_identity(other):
+        return (f"duplicate: {other_name} already ranks the same camera spec, detector and collection (a reproduction "
+                f"of it is not a second row; to replace it, remove {other_name} first)")
+    theirs = {c["detections_sha256"]: name for name, c in other["conditions"].items()}
+    for cname, cond in sorted(data["conditions"].items()):
+        if cond["detections_sha256"] in theirs:
+            return (f"duplicate: conditions.{cname}.detections_sha256 {cond['detections_sha256'][:12]}... is the "
+                    f"detections of {other_name} (conditions.{theirs[cond['detections_sha256']]}); each run is its own")
+    return None
 
 
 def check_not_duplicate(data: dict, leaderboard_dir: str | Path, *, path: str | Path | None = None) -> None:
-    """Refuse a name already taken, or the same system and detections under another name.
+    """Refuse a name already taken, the same system (:func:`system_identity`) under another
+    name, or another entry's detections.
 
     ``path``: where ``data`` was read from; the file itself is not its own duplicate.
     """
@@ -252,16 +366,15 @@ def check_not_duplicate(data: dict, leaderboard_dir: str | Path, *, path: str | 
     own = Path(path).resolve() if path is not None else None
     if target.exists() and target.resolve() != own:
         raise SubmissionError(f"duplicate name: {target} already exists (choose another --name)")
-    mine = _identity(data)
     for other in sorted(folder.glob("*.json")) if folder.is_dir() else []:
         if other.resolve() in (own, target.resolve()):
             continue
         try:
-            theirs = _identity(json.loads(other.read_text(encoding="utf-8")))
+            problem = duplicate_problem(data, json.loads(other.read_text(encoding="utf-8")), other.name)
         except (ValueError, KeyError, TypeError, AttributeError, OSError):
             continue  # a broken file is reported when the table is rendered
-        if theirs == mine:
-            raise SubmissionError(f"duplicate: {other.name} has the same camera, detector, collection and detections")
+        if problem:
+            raise SubmissionError(problem)
 
 
 def verify_detections(data: dict, detections: list[str | Path], groundtruth: str | Path, *, source: str = "submission") -> list[str]:

@@ -7,7 +7,9 @@ COCO YOLOv5 in the feasibility study (``reference/car-detectability.md``).
 
 Car frame: origin on the ground under the car's centre, x toward the front, y left, z up.
 ``car_parts(spec, (x, y), yaw)`` places it in the world (yaw = 0: front along +x, away from
-the camera at the origin; yaw = pi: oncoming).
+the camera at the origin; yaw = pi: oncoming). Where asked, it also carries what a car carries
+at night beyond its lamps (:func:`rear_fittings`): a lit rear plate (UN ECE R4) and two red
+rear retro-reflectors (UN ECE R3, :mod:`metricscenes.assets.retroreflection`).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 
 from metricscenes.assets import beams
 from metricscenes.assets import lamps as lamp_photometry
-from metricscenes.assets import materials
+from metricscenes.assets import ego_vehicle, materials, retroreflection
 from metricscenes.assets.car_body import BodyShape
 from metricscenes.assets.car_parts import (
     LampRect, MeshPart, conformal_patch, finish, lamp_rect, mirror_meshes, normals_for,
@@ -149,8 +151,7 @@ def _front_and_rear(body: BodyShape, spec: CarSpec, pre: str, parts: list[MeshPa
     parts.append(MeshPart(f"{pre}_intake", iv, if_, "trim_black", smooth=False))
     parts += _plate(body, pre + "_plate_f", True, zb + 0.33 * span)
     # rear face
-    zb, zt = float(body.z_bot(0.01)), float(body.z_top(0.03))
-    span = zt - zb
+    zb, span = _rear_face(body)
     if style in ("pickup", "van"):
         tw, th = 0.07, 0.20 * span / 0.6
         ty, tz = 0.5 * W - 0.06 - tw, zb + 0.62 * span
@@ -163,17 +164,69 @@ def _front_and_rear(body: BodyShape, spec: CarSpec, pre: str, parts: list[MeshPa
         lamps.append(lamp_rect(body, f"{pre}_taillamp_{side}", "tail", False, sgn * ty, tz, (tw, th), "lens_red"))
     bv, bf = conformal_patch(body, False, 0.0, zb + 0.10 * span, 0.40 * W, 0.08 * span, 0.004, 5.0)
     parts.append(MeshPart(f"{pre}_rearbumper", bv, bf, "trim_black", smooth=False))
-    parts += _plate(body, pre + "_plate_r", False, zb + 0.45 * span)
+    parts += _plate(body, pre + "_plate_r", False, _rear_plate_z(zb, span))
     if "bed" in STYLES[style]:
         u0, u1 = STYLES[style]["bed"]
         parts.append(_bed_floor(body, pre, u0, u1))
     return lamps
 
 
+def _rear_face(body: BodyShape) -> tuple[float, float]:
+    """(z of the rear face's bottom, its height): the frame the rear details are placed in."""
+    zb, zt = float(body.z_bot(0.01)), float(body.z_top(0.03))
+    return zb, zt - zb
+
+
+def _rear_plate_z(zb: float, span: float) -> float:
+    return zb + 0.45 * span
+
+
+PLATE_HALF_M = (0.26, 0.055)
+"""Half sizes (m) of an EU registration plate (520 x 110 mm)."""
+
+
 def _plate(body: BodyShape, key: str, front: bool, z: float) -> list[MeshPart]:
     """EU plate 520 x 110 mm of retroreflective white sheeting (characters are sub-pixel at 25 m)."""
-    pv, pf = conformal_patch(body, front, 0.0, z, 0.26, 0.055, 0.006, 12.0, n=(8, 4))
+    pv, pf = conformal_patch(body, front, 0.0, z, *PLATE_HALF_M, 0.006, 12.0, n=(8, 4))
     return [MeshPart(key, pv, pf, "plate_white", smooth=False)]
+
+
+PLATE_LAMP_ROLE = "plate"
+REFLECTOR_ROLE = "reflector"
+REFLECTOR_HEIGHT_SHARE = 0.25
+"""Height of the rear reflectors' centres, as a share of the rear face above its bottom:
+in the bumper, between its trim and the plate (0.45-0.62 m above the ground)."""
+REFLECTOR_INSET_M = 0.25
+"""How far in from the car's side a rear reflector's centre lies (its outer edge 200 mm in:
+UN ECE R48 asks at most 400 mm; there the body faces within 20° of straight back)."""
+
+
+@lru_cache(maxsize=64)
+def rear_fittings(spec: CarSpec) -> tuple[LampRect, ...]:
+    """The rear plate's lit face and the two rear retro-reflectors, in the car frame.
+
+    - Plate (role ``'plate'``, UN ECE R4): a flat rectangle of the plate's size and
+      material 10 mm proud of the body (4-7 mm before the plate, which stays behind it),
+      the face the plate lamp lights.
+    - Reflectors (role ``'reflector'``, red lens, :data:`retroreflection.REFLECTOR_HALF_M`):
+      low in the bumper, near the sides, as UN ECE R48 §6.14 places them: outer edges
+      within 400 mm of the car's sides, inner edges at least 600 mm apart, 250-900 mm above
+      the ground (tested for every car).
+
+    They are not in :func:`car_geometry` (nor in :func:`car_vertices_world`): a collection
+    without them keeps its bytes, and they lie inside the rear face's outline.
+    """
+    body = body_shape(spec)
+    pre = f"car_{spec.car_id:02d}"
+    zb, span = _rear_face(body)
+    plate = lamp_rect(body, f"{pre}_platelamp", PLATE_LAMP_ROLE, False, 0.0, _rear_plate_z(zb, span), PLATE_HALF_M,
+                      "plate_white", offset_m=0.010)
+    y = 0.5 * spec.width_m - REFLECTOR_INSET_M
+    z = zb + REFLECTOR_HEIGHT_SHARE * span
+    reflectors = tuple(lamp_rect(body, f"{pre}_reflector_{side}", REFLECTOR_ROLE, False, sgn * y, z,
+                                 retroreflection.REFLECTOR_HALF_M, "lens_red")
+                       for side, sgn in (("l", 1.0), ("r", -1.0)))
+    return (plate,) + reflectors
 
 
 def _bed_floor(body: BodyShape, pre: str, u0: float, u1: float) -> MeshPart:
@@ -201,15 +254,19 @@ def car_vertices_world(spec: CarSpec, position_m, yaw_rad) -> np.ndarray:
     return v @ m[:3, :3].T + m[:3, 3]
 
 
-def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, lights: str = "auto") -> SceneParts:
-    """Mitsuba shapes and lamps (light group 'car_lights') of a car placed in the world.
+def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, lights: str = "auto", *,
+              plate_lamp: bool = False, rear_retroreflectors: bool = False) -> SceneParts:
+    """Mitsuba shapes and lamps of a car placed in the world (its own lamps: group 'car_lights').
 
     ``lights``: 'auto'/'on' (low-beam head lamps with a road-lighting spot each, tail lamps),
     'brake' (as 'on' with stop-lamp intensity at the rear), 'off' (no emitters; lenses stay).
+    ``plate_lamp``: the rear plate's lit face (UN ECE R4), a 'car_lights' lamp while the
+    lights are on (a plain plate when 'off'). ``rear_retroreflectors``: the two red rear
+    reflectors (UN ECE R3), lit by the camera car's low beams whatever ``lights`` says,
+    lamps of group 'ego_lights' (:mod:`metricscenes.assets.retroreflection`); where they
+    return nothing to the camera (a car facing it) they are lenses only.
     The variant (``scalar_spectral``) must be set by the caller.
     """
-    import mitsuba as mi
-
     if lights not in LIGHT_MODES:
         raise ValueError(f"lights must be one of {LIGHT_MODES}, got {lights!r}")
     geo = car_geometry(spec)
@@ -224,8 +281,7 @@ def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, li
                                    None if n is None else n @ rot.T)
     lamps: list[Lamp] = []
     for lr in geo.lamps:
-        shape = {"type": "rectangle", "to_world": mi.ScalarTransform4f((m @ lr.matrix()).tolist()),
-                 "bsdf": materials.bsdf(lr.material)}
+        shape = _lamp_shape(lr, m)
         if lights == "off":
             shapes[lr.key] = shape
             continue
@@ -240,4 +296,48 @@ def car_parts(spec: CarSpec, position_m: tuple[float, float], yaw_rad: float, li
             lamps.append(Lamp(lr.key + "_beam", "car_lights", None, beams.head_lamp_spot(
                 "low", lamp_photometry.headlamp_spd(spec.headlamp_kind), origin, rot[:, 0],
                 lens_cd=beams.HEADLAMP_LENS_CD)))
+    for lr in rear_fittings(spec):
+        if lr.role == PLATE_LAMP_ROLE and plate_lamp:
+            lamp = None if lights == "off" else _plate_lamp(lr, m)
+        elif lr.role == REFLECTOR_ROLE and rear_retroreflectors:
+            lamp = _retroreflector(lr, m)
+        else:
+            continue
+        if lamp is None:
+            shapes[lr.key] = _lamp_shape(lr, m)
+        else:
+            lamps.append(lamp)
     return SceneParts(shapes=shapes, lamps=tuple(lamps))
+
+
+def _lamp_shape(lr: LampRect, world: np.ndarray) -> dict:
+    """Mitsuba ``rectangle`` of a lamp rectangle placed by the 4x4 ``world`` transform."""
+    import mitsuba as mi
+
+    return {"type": "rectangle", "to_world": mi.ScalarTransform4f((world @ lr.matrix()).tolist()),
+            "bsdf": materials.bsdf(lr.material)}
+
+
+def _plate_lamp(lr: LampRect, world: np.ndarray) -> Lamp:
+    """The rear plate lit by its lamp: a 'car_lights' emitter of the plate's radiance (R4's
+    minimum luminance on a perfect diffuser, times the plate's reflectance), never chosen
+    by next-event estimation (its 0.1 cd barely lights anything else)."""
+    wl, rad = lamp_photometry.plate_lamp(materials.reflectance(lr.material, lamp_photometry.LAMP_NM))
+    return Lamp(lr.key, "car_lights", _lamp_shape(lr, world), lamp_photometry.area_emitter(wl, rad, sampled=False))
+
+
+def _retroreflector(lr: LampRect, world: np.ndarray) -> Lamp | None:
+    """A rear reflector returning the ego low beams to the camera: an 'ego_lights' emitter
+    whose intensity towards the camera is :func:`retroreflection.returned_intensity_cd`,
+    spread as a Lambertian lens does (L = I / (A cos θ)), or None where it returns nothing."""
+    rot = world[:3, :3]
+    centre, normal = rot @ lr.centre + world[:3, 3], rot @ lr.normal
+    rearward = -rot[:, 0]  # R3's reference axis: straight back along the car
+    to_camera = np.asarray(ego_vehicle.CAMERA_POSITION_M) - centre
+    cos_camera = float(np.dot(normal, to_camera) / np.linalg.norm(to_camera))
+    intensity = retroreflection.returned_intensity_cd(centre, rearward)
+    if intensity <= 0.0 or cos_camera <= 0.0:
+        return None
+    wl, rad = lamp_photometry.retroreflected_red(ego_vehicle.LAMP_SPECTRUM, intensity / (lr.area_m2 * cos_camera))
+    return Lamp(lr.key, retroreflection.EGO_GROUP, _lamp_shape(lr, world),
+                lamp_photometry.area_emitter(wl, rad, sampled=False))

@@ -14,6 +14,10 @@ from __future__ import annotations
 
 from metricscenes.assets import beams
 from metricscenes.assets.parts import Lamp, SceneParts
+from metricscenes.geometry import CAMERA_HEIGHT_M
+
+CAMERA_POSITION_M = (0.0, 0.0, CAMERA_HEIGHT_M)
+"""Where the camera sits (world m): the origin of every scene, 1.5 m above the road."""
 
 LAMP_AHEAD_OF_CAMERA_M = 2.0
 LAMP_HEIGHT_M = 0.70

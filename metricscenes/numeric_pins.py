@@ -1,0 +1,97 @@
+"""Numeric libraries pinned to the same kernels on every x86-64 machine, and what ran.
+
+numpy and OpenBLAS choose their SIMD kernels when they load, by the CPU they find: on a
+machine with AVX-512, numpy's float32 ``power``/``exp``/``log``… and OpenBLAS's matrix
+products take other kernels than on an AVX2 machine, and their results differ in the last
+bit (measured here: forcing OpenBLAS's Sandybridge kernels on this AVX2 machine changes
+every camera image of a smoke run). Both read their choice from the environment once, at
+load, so this module sets it before numpy is imported:
+
+- ``OPENBLAS_CORETYPE=Haswell`` (AVX2 + FMA kernels) where the CPU has AVX2 and FMA, which
+  every AVX-512 CPU has too; elsewhere OpenBLAS keeps its own choice, recorded.
+- ``NPY_DISABLE_CPU_FEATURES`` += the AVX-512 groups (numpy then dispatches to its AVX2
+  kernels, as on an AVX2 machine).
+
+A value the user set is kept. What cannot be pinned from Python — Mitsuba's ray tracer
+(Embree picks its AVX2 or AVX-512 kernels itself) and onnxruntime's CPU kernels (MLAS,
+likewise) — is recorded by :func:`numeric_provenance`, and docs/performance.md ("Bytes
+across machines") says what is therefore identical across machines and what only agrees.
+
+Nothing here imports numpy: :mod:`metricscenes` imports this module first.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from importlib.metadata import PackageNotFoundError, version
+
+OPENBLAS_CORETYPE = "Haswell"
+NUMPY_AVX512_GROUPS = ("X86_V4", "AVX512_ICL", "AVX512_SPR")
+BYTE_DECIDING_PACKAGES = ("mitsuba", "drjit", "numpy", "scipy", "onnxruntime", "zarr", "numcodecs",
+                          "colour-science", "colour-demosaicing", "pillow", "faster-coco-eval", "pycocotools")
+"""The packages whose versions decide the bytes of a collection, a capture or a score."""
+
+
+def cpu_flags() -> frozenset[str]:
+    """The CPU's feature flags as Linux reports them (empty where /proc/cpuinfo is absent)."""
+    try:
+        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
+            for line in f:
+                if line.startswith("flags"):
+                    return frozenset(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return frozenset()
+
+
+def isa_class(flags: frozenset[str] | None = None) -> str:
+    """'avx512', 'avx2' or 'other': the kernel class Embree and onnxruntime take here."""
+    flags = cpu_flags() if flags is None else flags
+    if {"avx512f", "avx512vl", "avx512bw", "avx512dq"} <= flags:
+        return "avx512"
+    if {"avx2", "fma"} <= flags:
+        return "avx2"
+    return "other"
+
+
+def pin_numeric_libraries(environ=os.environ) -> bool:
+    """Set the kernel choices above unless numpy is already loaded; True if they hold."""
+    if "numpy" in sys.modules:
+        return pins_hold(environ)
+    if {"avx2", "fma"} <= cpu_flags():
+        environ.setdefault("OPENBLAS_CORETYPE", OPENBLAS_CORETYPE)
+    disabled = environ.get("NPY_DISABLE_CPU_FEATURES", "").replace(",", " ").split()
+    environ["NPY_DISABLE_CPU_FEATURES"] = " ".join(dict.fromkeys(disabled + list(NUMPY_AVX512_GROUPS)))
+    return pins_hold(environ)
+
+
+def pins_hold(environ=os.environ) -> bool:
+    disabled = set(environ.get("NPY_DISABLE_CPU_FEATURES", "").replace(",", " ").split())
+    blas_ok = environ.get("OPENBLAS_CORETYPE") == OPENBLAS_CORETYPE or not {"avx2", "fma"} <= cpu_flags()
+    return blas_ok and set(NUMPY_AVX512_GROUPS) <= disabled
+
+
+def package_versions() -> dict[str, str | None]:
+    """Installed version of each byte-deciding package (None: not installed)."""
+    out = {}
+    for name in BYTE_DECIDING_PACKAGES:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+def numeric_provenance() -> dict:
+    """What decided the bytes of this process's numbers: versions, ISA class, kernels."""
+    from threadpoolctl import threadpool_info
+
+    blas = sorted({str(i.get("architecture")) for i in threadpool_info() if i.get("internal_api") == "openblas"})
+    return {
+        "versions": package_versions(),
+        "isa_class": isa_class(),
+        "openblas_coretype": blas,
+        "numpy_disabled_features": os.environ.get("NPY_DISABLE_CPU_FEATURES", ""),
+        "pinned": pins_hold(),
+    }

@@ -1,0 +1,50 @@
+"""Progress in a log (issue 26): where standard error is not a terminal, generate, run and
+sweep print a plain line every 5 % of their units or every 30 s, not a silent rich bar."""
+
+from __future__ import annotations
+
+import io
+
+from rich.console import Console
+
+from metricscenes.cli_support import LogProgress, progress_bar
+
+
+def _lines(console_file: io.StringIO) -> list[str]:
+    return [line for line in console_file.getvalue().splitlines() if line]
+
+
+def test_a_log_gets_a_line_every_five_percent_or_thirty_seconds():
+    out = io.StringIO()
+    now = [0.0]
+    progress = LogProgress(Console(file=out, width=200), clock=lambda: now[0])
+    task = progress.add_task("rendering quick", total=None)
+    for done in range(1, 201):  # 200 units, one every 0.1 s: 20 s in all, so only the 5 % steps print
+        now[0] += 0.1
+        progress.update(task, completed=done, total=200)
+    lines = _lines(out)
+    assert len(lines) == 20 and lines[-1].startswith("rendering quick: 200/200 (100 %)")
+    assert lines[0] == "rendering quick: 10/200 (5 %), 0 min 01 s elapsed, about 0 min 19 s left"
+    now[0] += 31.0  # a long unit: a line after 30 s even without a step
+    progress.update(task, description="rendering env000")
+    assert _lines(out)[-1].startswith("rendering env000: 200/200")
+
+
+def test_slow_units_print_every_thirty_seconds():
+    out = io.StringIO()
+    now = [0.0]
+    progress = LogProgress(Console(file=out, width=200), clock=lambda: now[0])
+    task = progress.add_task("sweep", total=1000)
+    for done in range(1, 11):  # 1 % per 20 s
+        now[0] += 20.0
+        progress.update(task, completed=done)
+    assert len(_lines(out)) == 5  # at 40, 80, 120, 160 and 200 s
+
+
+def test_progress_bar_is_plain_lines_off_a_terminal_and_rich_on_one():
+    with progress_bar(Console(file=io.StringIO())) as bar:
+        assert isinstance(bar, LogProgress)
+    with progress_bar(Console(file=io.StringIO(), force_terminal=True)) as bar:
+        assert not isinstance(bar, LogProgress)
+    with progress_bar(Console(file=io.StringIO()), disable=True) as bar:  # --json: nothing at all
+        assert not isinstance(bar, LogProgress)
