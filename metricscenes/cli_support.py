@@ -58,6 +58,9 @@ class LogProgress:
             t["printed_at"], t["printed_fraction"] = now, fraction
             self.console.print(self.line(t, now), highlight=False, soft_wrap=True, markup=False)
 
+    def advance(self, task: int, advance: float = 1) -> None:
+        self.update(task, completed=self.tasks[task]["completed"] + advance)
+
     @staticmethod
     def line(t: dict, now: float) -> str:
         elapsed = now - t["started"]

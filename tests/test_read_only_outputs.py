@@ -186,7 +186,7 @@ def _fake_run(out: Path, monkeypatch):
             return [[] for _ in images]
 
     class Collection(FakeCollection):
-        def radiance(self, scene_id, condition):
+        def radiance(self, scene_id, condition, inset_resolution="car"):
             return None
 
         def condition_record(self, scene_id, condition):

@@ -84,7 +84,7 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
     assert captures is None, "fake_run_camera does not read another sweep's captures"
     from PIL import Image, ImageDraw
 
-    from benchmark.experiments.run import sha256_bytes
+    from benchmark.experiments.run import COMPOSITE, sha256_bytes
     from benchmark.result_files import RunResults, write_results
     from metricscenes.groundtruth import scale_groundtruth
 
@@ -113,7 +113,7 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
         "detector": {"name": detector.name, "sha256": detector.sha256, "input_size": detector.input_size},
         "collection": {"name": collection.name, "manifest_sha256": collection.manifest_sha256, "path": str(collection.root)},
         "seed": seed, "scoring_backend": backend, "per_distance": per_distance, "od50_m": None,
-        "detections_sha256": sha256_bytes(data),
+        "detections_sha256": sha256_bytes(data), "composite": COMPOSITE,
     })
     (out_dir / "detections.json").write_bytes(data)
     (out_dir / "groundtruth.json").write_text(json.dumps(gt))

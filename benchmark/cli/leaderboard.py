@@ -36,6 +36,7 @@ def submit(
         build_submission, check_not_duplicate, check_submission_file, find_runs, group_by_camera, load_protocols,
         write_submission,
     )  # fmt: skip
+    from benchmark.leaderboard.submission import software_differences
 
     try:
         check_leaderboard_dir(leaderboard, "--leaderboard")
@@ -47,6 +48,10 @@ def submit(
             conditions = ", ".join(sorted(data["conditions"]))
             recomputed = f"; AP recomputed from {len(detections)} detections file(s)" if detections else ""
             typer.echo(f"ok: {check.name} (protocol {data['collection']['protocol']}, conditions {conditions}{recomputed})")
+            differences = software_differences(data)
+            if differences:  # a reproduction here need not give the same bytes (docs/performance.md)
+                typer.echo(f"warning: {check.name} was made with {'; '.join(differences)}: a rerun here may give "
+                           "other bytes (AP within about 0.015 per distance)", err=True)
             return
         if results_dir is None or name is None:
             fail("give RESULTS_DIR and --name (or --check FILE)")

@@ -210,9 +210,27 @@ def build_submission(
     }  # fmt: skip
     if notes:
         submission["notes"] = notes
+    if first.numerics is not None:  # runs made since session 12 say what decided their bytes
+        submission["software"] = {"versions": first.numerics["versions"], "isa_class": first.numerics["isa_class"]}
     if spec.sha256() != first.camera.spec_sha256:
         raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")
     return validate_submission(submission, protocols=protocols, source=name)
+
+
+def software_differences(submission: dict) -> list[str]:
+    """How this machine differs from the one that made a submission's runs, in what decides
+    bytes (versions, kernel class); empty where it does not or the submission does not say."""
+    from metricscenes.numeric_pins import isa_class, package_versions
+
+    software = submission.get("software")
+    if not software:
+        return []
+    here = package_versions()
+    out = [f"{name} {made} (here {here.get(name)})" for name, made in sorted(software["versions"].items())
+           if here.get(name) != made]
+    if software["isa_class"] != isa_class():
+        out.append(f"made on an x86-64 {software['isa_class']} machine (here {isa_class()})")
+    return out
 
 
 def dumps_submission(submission: dict) -> str:
