@@ -173,27 +173,10 @@ def _fake_run(out: Path, monkeypatch):
     import benchmark.camera.pipeline
     from benchmark.camera import load_camera
     from benchmark.experiments.run import run_camera
-    from test_sweep_cache import FakeCollection
+    from test_sweep_cache import BlankCapture, BlankCollection, BlindDetector
 
-    class Capture:
-        rgb8 = np.zeros((8, 8, 3), np.uint8)
-        exposure_s, exposure_short_s = 1e-3, None
-
-    class Detector:
-        name, family, sha256, input_size = "none", "none", "0" * 64, "native"
-
-        def detect(self, images, **kw):
-            return [[] for _ in images]
-
-    class Collection(FakeCollection):
-        def radiance(self, scene_id, condition, inset_resolution="car"):
-            return None
-
-        def condition_record(self, scene_id, condition):
-            return None
-
-    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
-    return run_camera(Collection(out.parent), load_camera("cam01"), "day", Detector(), out, save_images=False)
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: BlankCapture())
+    return run_camera(BlankCollection(out.parent), load_camera("cam01"), "day", BlindDetector(), out, save_images=False)
 
 
 def test_a_second_writer_of_a_run_folder_is_refused_naming_the_first(tmp_path, monkeypatch):

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -45,23 +44,10 @@ def test_parse_subset_ranges_and_errors(tmp_path):
 def test_run_camera_records_the_subset(tmp_path, monkeypatch):
     """The real run_camera on a subset: only the chosen scenes, ground truth to match, results.json marked."""
     import benchmark.camera.pipeline
+    from test_sweep_cache import BlankCapture, BlankCollection, BlindDetector as Detector
 
-    class Capture:
-        rgb8 = np.zeros((8, 8, 3), np.uint8)
-        exposure_s, exposure_short_s = 1e-3, None
-
-    class Detector:
-        name, family, sha256, input_size = "none", "none", "0" * 64, "native"
-
-        def detect(self, images, **kw):
-            return [[] for _ in images]
-
-    class Collection(FakeCollection):
-        def radiance(self, scene_id, condition, inset_resolution="car"):
-            return None
-
-    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: Capture())
-    col = Collection(tmp_path)
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: BlankCapture())
+    col = BlankCollection(tmp_path)
     view = subset_collection(col, "1", None)
     results = run_camera(view, load_camera("cam01"), "day", Detector(), tmp_path / "run", save_images=False)
     assert results.subset.environments == [1]

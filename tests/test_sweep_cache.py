@@ -51,6 +51,29 @@ class FakeCollection:
         return None
 
 
+class BlankCollection(FakeCollection):
+    """A FakeCollection for the real run_camera with ``simulate`` replaced: no radiance."""
+
+    def radiance(self, scene_id, condition, inset_resolution="car"):
+        return None
+
+
+class BlankCapture:
+    """What a replaced ``simulate`` returns: a black 8 x 8 image."""
+
+    rgb8 = np.zeros((8, 8, 3), np.uint8)
+    exposure_s, exposure_short_s = 1e-3, None
+
+
+class BlindDetector:
+    """A detector that finds nothing (fast)."""
+
+    name, family, sha256, input_size = "none", "none", "0" * 64, "native"
+
+    def detect(self, images, **kw):
+        return [[] for _ in images]
+
+
 @dataclass
 class FakeDetector:
     name: str = "fake-yolo"
