@@ -38,15 +38,23 @@ def generate(
     workers: Annotated[int, typer.Option(min=1, help="render processes")] = 1,
     threads: Annotated[Optional[int], typer.Option(min=1, help="render threads per process")] = None,
     scheduler: Annotated[Optional[str], typer.Option(help=SCHEDULER_HELP)] = None,
+    conditions: Annotated[Optional[str], typer.Option(
+        help="render only the light groups these conditions need: day,dusk (default: all; run again with more "
+             "to add theirs)")] = None,
+    light_groups: Annotated[Optional[str], typer.Option(
+        "--light-groups", help="render only these light groups (and those --conditions need): sky_day,ego_lights")
+    ] = None,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="print the plan, render nothing")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
 ) -> None:
     """Render a collection (resumes an interrupted run; same manifest → same bytes)."""
+    from metricscenes.generate import requested_light_groups
     from metricscenes.manifest import load_manifest
     from metricscenes.plan import plan_collection
 
     try:
         m = load_manifest(manifest)
+        asked = requested_light_groups(m, _names(conditions), _names(light_groups))
         if dry_run:
             scenes = [s.summary() for s in plan_collection(m)]
             if as_json:
@@ -59,6 +67,7 @@ def generate(
         from metricscenes.generate import check_before_writing
         from metricscenes.generate import generate as run_generate
         from metricscenes.outputs import COLLECTION, check_output
+        from metricscenes.store import Collection
 
         check_output(out, "--out", own=COLLECTION)  # not inside a run, sweep or leaderboard folder
 
@@ -74,17 +83,25 @@ def generate(
                 bar.update(task, completed=done, total=total, description=f"rendering {key or m.name}")
 
             run_generate(m, out, workers=workers, threads=threads, scheduler=scheduler, progress=progress,
-                         notice=lambda line: err.print(line, highlight=False, soft_wrap=True))
+                         notice=lambda line: err.print(line, highlight=False, soft_wrap=True), light_groups=asked)
         seconds = time.perf_counter() - started
+        held = Collection.open(out).light_groups
         if as_json:
-            print(json.dumps({"collection": str(out), "seconds": round(seconds, 2)}))
+            print(json.dumps({"collection": str(out), "seconds": round(seconds, 2), "light_groups": list(held)}))
         else:
-            console.print(f"wrote {out} in {seconds:.1f} s")
+            more = (f"; it holds {', '.join(held)}: run again with more --conditions (or none: all) to add the others"
+                    if held != m.light_groups else "")
+            console.print(f"wrote {out} in {seconds:.1f} s{more}", highlight=False)
     except _user_errors() as exc:
         fail(str(exc))
     except OSError as exc:  # --out unwritable, disk full: one line, the lock released
         where = f" ({exc.filename})" if exc.filename else ""
         fail(f"cannot write {out}{where}: {exc.strerror or type(exc).__name__}")
+
+
+def _names(text: str | None) -> tuple[str, ...]:
+    """The names of a comma list (None: none)."""
+    return tuple(name.strip() for name in (text or "").split(",") if name.strip())
 
 
 def _plan_table(scenes: list[dict]) -> None:
@@ -119,12 +136,13 @@ def info(
         "render_variant": c.render_variant, "scenes": len(scenes),
         "environments": len({s.environment_id for s in scenes}),
         "distances_m": sorted({s.distance_m for s in scenes}), "conditions": c.condition_names,
+        "light_groups": list(c.light_groups), "conditions_held": c.held_condition_names,
         "reference_grid_px": list(c.reference_grid), "arrays": len(c.resolved.arrays),
         "radiance_units": "W sr-1 m-2 nm-1", "wavelengths_nm": [400, 700, 10], "store_bytes": size,
     }
     if photometry:  # reads every scene's radiance: damage found on the way is one line
         try:
-            summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.condition_names]
+            summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.held_condition_names]
         except _user_errors() as exc:
             fail(str(exc))
     if as_json:
@@ -137,6 +155,9 @@ def info(
     for k, v in summary.items():
         table.add_row(k, str(v))
     console.print(table)
+    if len(c.light_groups) < len(c.manifest.light_groups):
+        console.print(f"holds {len(c.light_groups)} of its {len(c.manifest.light_groups)} light groups; add the others "
+                      f"with: {c.generate_command()}", highlight=False, soft_wrap=True)
 
 
 def _photometry_table(rows: list[dict]) -> None:

@@ -10,6 +10,11 @@ and whose arrays still match the record's sha256 (a damaged or deleted array is
 rendered again), so a killed run resumes and a damaged collection is repaired, and
 because every unit is a pure function of the manifest the result is bit-identical to
 an uninterrupted run, whatever the number of workers.
+
+A run may render some of the manifest's light groups only (``generate --conditions day``:
+:func:`requested_light_groups`); a later run with more adds the missing ones to each unit.
+A group's render keeps the seed and window it has in a render of all of them, so its
+bytes do not depend on which others were rendered with it (:func:`light_groups_to_render`).
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ import numpy as np
 from metricscenes.backends import check_scheduler, is_remote, map_units, threads_per_unit
 from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, mask_box_tan
-from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest
+from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest, ManifestError
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.records import PLATE, InsetTruth, RecordError, UnitRecord
 from metricscenes.store import PROGRESS_DIR, RADIANCE_STORE, CollectionError, read_checked
@@ -98,10 +103,12 @@ def shadow_vertices(vertices_world_m: np.ndarray, towards_light, plane_z_m: floa
 
 
 def shadow_box_tan(manifest: Manifest, env: EnvironmentPlan, car_vertices_m: np.ndarray):
-    """The box (tangent coordinates) of the car's shadows on the road under every rendered
-    sky's sun or moon when ``render.inset_shadow`` is set, else None (also when no sky has one)."""
+    """The box (tangent coordinates) of the car's shadows on the road under every sky's sun
+    or moon of the manifest when ``render.inset_shadow`` is set, else None (also when no sky
+    has one)."""
     if not manifest.render.inset_shadow:
         return None
+    # Every sky of the manifest, rendered in this run or not: a group added later lands in the same window.
     lights = shadow_light_directions(env, manifest.light_groups)
     boxes = [car_box_tan(shadow_vertices(car_vertices_m, d)) for d in lights]
     if not boxes:
@@ -143,9 +150,14 @@ def inset_window(box_tan, manifest: Manifest, cover_tan=None) -> tuple[int, int,
     return k, cx0, cy0, cx1 - cx0, cy1 - cy0
 
 
-def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None, variant: str) -> UnitRecord:
+def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | None, variant: str,
+                light_groups: tuple[str, ...] | None = None, held: UnitRecord | None = None) -> UnitRecord:
     """Render and write one unit (runs in a worker process) with the Mitsuba ``variant``
-    (the manifest's, ``auto`` resolved); return its progress record (the caller writes it)."""
+    (the manifest's, ``auto`` resolved); return its progress record (the caller writes it).
+
+    ``light_groups``: the groups to render (None: all of the manifest's; on a JIT variant
+    whole passes of :func:`light_groups_to_render`). ``held``: the unit's record, whose
+    groups are kept and to which these are added (its mask and box too), or None."""
     from metricscenes import scene as scene_mod
     from metricscenes.photometry import radiance_to_xyz
     from metricscenes.lightgroups import meter_pass, render_pass
@@ -161,7 +173,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     field = manifest.reference_grid.field
     env = unit.environment
     parts = scene_mod.environment_parts(env, ground_to_horizon=bool(manifest.render.ground_to_horizon))
-    inset = None
+    inset = None if held is None else held.inset
     started = time.perf_counter()
     if unit.kind == PLATE:
         groups = [g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
@@ -172,12 +184,13 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
         parts = parts.merged(scene_mod.car_parts(env, pose, plate_lamp=bool(manifest.render.plate_lamp),
                                                  rear_retroreflectors=bool(manifest.render.rear_retroreflectors)))
         film, extent, projected_box, k = _inset_film(manifest, scene_mod.car_vertices(env, pose), env)
-        mask, mask_box = _instance_mask(manifest, unit, env_parts, parts, film, extent)
-        arrays.write_mask(mask, extent)
-        grid = manifest.reference_grid
-        inset = InsetTruth(pose=asdict(pose), projected_box_tan=tuple(projected_box), inset_scale=k,
-                           box_tan=tuple(mask_box), mask_iou=round(box_iou(mask_box, projected_box), 4),
-                           bbox_xywh=tuple(box_tan_to_xywh(mask_box, grid.width_px, grid.height_px, grid.field)))
+        if held is None:  # (a unit adding groups keeps its mask, which no light group changes)
+            mask, mask_box = _instance_mask(manifest, unit, env_parts, parts, film, extent)
+            arrays.write_mask(mask, extent)
+            grid = manifest.reference_grid
+            inset = InsetTruth(pose=asdict(pose), projected_box_tan=tuple(projected_box), inset_scale=k,
+                               box_tan=tuple(mask_box), mask_iou=round(box_iou(mask_box, projected_box), 4),
+                               bbox_xywh=tuple(box_tan_to_xywh(mask_box, grid.width_px, grid.height_px, grid.field)))
         jobs = [("insets", g, film, manifest.render.inset_spp, extent) for g in manifest.light_groups]
         if "car_lights" in manifest.light_groups:
             # The car's lamps light the road far outside its inset (an oncoming car's beams
@@ -185,9 +198,13 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
             jobs.append(("frames", "car_lights", Film(*manifest.frame_grid_px(), field=field),
                          manifest.render.plate_spp, field))
     illuminance = {}
+    # Every job keeps its index among all of the unit's jobs, and so its seed, whichever are rendered now.
     lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
     one_pass = is_jit_variant(variant)
+    wanted = set(manifest.light_groups if light_groups is None else light_groups)
     for seeds, (kind, film, spp, extent), groups in _renders(lit, one_pass=one_pass):
+        if not wanted & set(groups):
+            continue
         images = render_pass(env, parts, groups, film, spp=spp, seed=unit.seed + 7919 * seeds[0],
                              max_depth=manifest.render.max_depth)
         for group in groups:
@@ -203,10 +220,55 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
                                      max_depth=manifest.render.max_depth), seed=unit.seed + 7919 * i)
                 for i, group in zip(seeds, groups)}
         illuminance.update({g: round(float(radiance_to_xyz(e)[1]), 9) for g, e in irradiance.items()})
-    return UnitRecord(unit=unit.key, kind=unit.kind, arrays=arrays.sha256,
-                      seconds=round(time.perf_counter() - started, 3),
+    written, attributes, seconds = arrays.sha256, arrays.attributes_sha256, time.perf_counter() - started
+    if held is not None:  # what the unit held, and what it rendered now
+        written, attributes = {**held.arrays, **written}, {**(held.attributes or {}), **attributes}
+        illuminance = {**(held.illuminance_lux or {}), **illuminance}
+        seconds += held.seconds
+        wanted |= set(unit_light_groups(held, manifest))
+    return UnitRecord(unit=unit.key, kind=unit.kind, arrays=written, seconds=round(seconds, 3),
                       illuminance_lux=illuminance or None,  # (a plate no group lights records none)
-                      inset=inset, attributes=arrays.attributes_sha256)
+                      inset=inset, attributes=attributes, light_groups=_fewer_than_all(wanted, manifest))
+
+
+def unit_light_groups(record: UnitRecord, manifest: Manifest) -> tuple[str, ...]:
+    """The light groups a finished unit holds (a record that names none holds all of them)."""
+    return manifest.light_groups if record.light_groups is None else record.light_groups
+
+
+def _fewer_than_all(groups, manifest: Manifest) -> tuple[str, ...] | None:
+    """``groups`` in the manifest's order, or None where they are all of its light groups
+    (how records and the resolved manifest write them: a full render's bytes are as before)."""
+    ordered = tuple(g for g in manifest.light_groups if g in set(groups))
+    return None if ordered == manifest.light_groups else ordered
+
+
+def requested_light_groups(manifest: Manifest, conditions=(), light_groups=()) -> tuple[str, ...] | None:
+    """The light groups that ``conditions`` (the manifest's, or its illuminance sweep's) and
+    ``light_groups`` need, in the manifest's order; None where neither names any (all of
+    them). :class:`~metricscenes.manifest.ManifestError` (one line) for a name it lacks."""
+    if not conditions and not light_groups:
+        return None
+    for group in light_groups:
+        if group not in manifest.light_groups:
+            raise ManifestError(f"light group {group!r} is not one of manifest {manifest.name}'s "
+                                f"({', '.join(manifest.light_groups)})")
+    wanted = set(light_groups).union(*(manifest.condition_light_groups(c) for c in conditions))
+    return tuple(g for g in manifest.light_groups if g in wanted)
+
+
+def light_groups_to_render(manifest: Manifest, light_groups, variant: str) -> tuple[str, ...]:
+    """``light_groups`` and, on a JIT variant, every group rendered in one pass with one of
+    them (:func:`metricscenes.lightgroups.passes`: the first sky with every lamp group), in
+    the manifest's order. A pass's groups share their random numbers, so rendering part of
+    one would give other bytes than a render of all groups; a whole pass gives the same."""
+    from metricscenes.lightgroups import passes
+    from metricscenes.render import is_jit_variant
+
+    chosen = set(light_groups)
+    if is_jit_variant(variant):
+        chosen = chosen.union(*(p for p in passes(manifest.light_groups) if chosen & set(p)))
+    return tuple(g for g in manifest.light_groups if g in chosen)
 
 
 def _renders(lit_jobs: list, one_pass: bool) -> list:
@@ -448,9 +510,16 @@ def _checked_root_and_variant(manifest: Manifest, out_dir: str | Path, workers: 
 
 
 def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threads: int | None = None,
-             scheduler: str | None = None, progress=None, notice=None) -> Path:
+             scheduler: str | None = None, progress=None, notice=None,
+             light_groups: tuple[str, ...] | None = None) -> Path:
     """Render ``manifest`` into ``out_dir`` (resuming what is already done, repairing
     what is damaged).
+
+    ``light_groups``: render only these of the manifest's (:func:`requested_light_groups`;
+    on a JIT variant with those sharing their one-pass renders, :func:`light_groups_to_render`),
+    besides those ``out_dir`` already holds; None: all of them. The collection records
+    which it holds (:attr:`metricscenes.store.Collection.light_groups`), and a later run
+    with more adds the missing groups to every unit.
 
     ``workers`` processes render units in parallel; each uses ``threads`` render
     threads (default: the CPU count divided by the workers). ``scheduler`` runs them on
@@ -459,8 +528,8 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
     workers must see ``out_dir`` at the same path; ``threads`` default: each worker's
     CPUs). The bytes do not depend on any of these. ``progress`` is an
     optional callable ``(done, total, unit_key)``; ``notice`` an optional callable that
-    gets one line per finished unit found damaged (it is rendered again) and one when a
-    stale lock is taken over.
+    gets one line per finished unit found damaged (it is rendered again), one when a
+    stale lock is taken over and one when a JIT variant renders more groups than asked.
 
     Before anything is created, :func:`check_before_writing` refuses a bad ``out_dir``, a
     scheduler that cannot be used, a render that would not fit in memory and a Mitsuba
@@ -469,24 +538,43 @@ def generate(manifest: Manifest, out_dir: str | Path, *, workers: int = 1, threa
     """
     root, variant = _checked_root_and_variant(manifest, out_dir, workers, scheduler)
     with CollectionWriter(root).locked(notice=notice) as writer:  # one writer at a time; released on errors too
-        _generate(manifest, writer, variant, workers, threads, scheduler, progress, notice)
+        _generate(manifest, writer, variant, workers, threads, scheduler, progress, notice, light_groups)
     return root
 
 
+def _target_light_groups(manifest: Manifest, records: dict[str, UnitRecord | None], light_groups,
+                         variant: str, notice) -> tuple[str, ...]:
+    """The light groups every unit holds when this run ends: those asked for (None: all),
+    with the groups sharing their one-pass renders, and every group a unit already holds
+    (a run that was adding groups when it stopped is finished)."""
+    asked = manifest.light_groups if light_groups is None else light_groups
+    rendered = light_groups_to_render(manifest, asked, variant)
+    held = {g for r in records.values() if r is not None for g in unit_light_groups(r, manifest)}
+    brought = [g for g in rendered if g not in asked and g not in held]
+    if brought and notice:
+        notice(f"{variant} renders a sky with every lamp group in one pass: also rendering {', '.join(brought)}")
+    return tuple(g for g in manifest.light_groups if g in held or g in rendered)
+
+
 def _generate(manifest: Manifest, writer: CollectionWriter, variant: str, workers: int, threads: int | None,
-              scheduler: str | None, progress, notice) -> None:
+              scheduler: str | None, progress, notice, light_groups: tuple[str, ...] | None) -> None:
     writer.prepare(manifest, variant)
     scenes = plan_collection(manifest)
     units = plan_units(scenes)
     records = _finished_units(writer, units, manifest, notice)
-    todo = [u for u in units if records[u.key] is None]
+    target = _target_light_groups(manifest, records, light_groups, variant, notice)
+    # A unit renders the target groups it lacks: all of them where it has no record (its mask too).
+    missing = {key: [g for g in target if record is None or g not in unit_light_groups(record, manifest)]
+               for key, record in records.items()}
+    todo = [u for u in units if missing[u.key]]
     threads = threads_per_unit(threads, workers, scheduler)
     manifest_json = manifest.model_dump(mode="json")
     done = len(units) - len(todo)
     if progress:
         progress(done, len(units), None)
     # Units finish in any order; each record is written here, by the client, as it arrives.
-    jobs = [(manifest_json, u, str(writer.root), threads, variant) for u in todo]
+    jobs = [(manifest_json, u, str(writer.root), threads, variant, tuple(missing[u.key]), records[u.key])
+            for u in todo]
     with closing(map_units(render_unit, jobs, workers=workers, scheduler=scheduler)) as finished:
         for record in finished:
             writer.write_record(record)
@@ -494,4 +582,4 @@ def _generate(manifest: Manifest, writer: CollectionWriter, variant: str, worker
             done += 1
             if progress:
                 progress(done, len(units), record.unit)
-    writer.finish(manifest, scenes, records, variant)
+    writer.finish(manifest, scenes, records, variant, _fewer_than_all(target, manifest))

@@ -354,6 +354,31 @@ class Manifest(_Strict):
                              f"({grid.width_px} x {grid.height_px} px)")
         return self
 
+    @property
+    def condition_names(self) -> list[str]:
+        """The conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
+        sweep = self.illuminance_sweep
+        levels = [illuminance_condition(sweep.base, lux) for lux in sweep.levels_lux] if sweep else []
+        return list(self.conditions) + levels
+
+    def condition_light_groups(self, condition: str) -> tuple[str, ...]:
+        """The light groups ``condition`` mixes, in ``light_groups``' order: those a condition
+        weights above 0 (a group at weight 0 adds nothing), a targeted condition's ambient
+        group and lamps, an illuminance-sweep level's base groups with its ambient group and
+        ``lamps_on``. :class:`ManifestError` for a name that is no condition."""
+        if condition not in self.condition_names:
+            raise ManifestError(f"unknown condition {condition!r} (manifest {self.name} has: "
+                                f"{', '.join(self.condition_names)})")
+        sweep = self.illuminance_sweep
+        spec = self.conditions.get(condition) or self.conditions[sweep.base]
+        if isinstance(spec, TargetedCondition):
+            mixed = {spec.ambient, *(g for g, w in spec.lamps.items() if w != 0.0)}
+        else:
+            mixed = {g for g, w in spec.items() if w != 0.0}
+        if condition not in self.conditions:  # a sweep level
+            mixed |= {sweep.ambient_group, *sweep.lamps_on}
+        return tuple(g for g in self.light_groups if g in mixed)
+
     def frame_grid_px(self) -> tuple[int, int]:
         """(width, height) of the car lamps' whole frame: the reference grid, or it divided
         by ``render.frame_divisor``."""

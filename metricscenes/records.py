@@ -42,6 +42,13 @@ def _box(data: dict, name: str) -> tuple:
     return tuple(value)
 
 
+def _names(data: dict, name: str) -> tuple[str, ...]:
+    value = data.get(name)
+    if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
+        raise RecordError(name)
+    return tuple(value)
+
+
 def _mapping(data: dict, name: str, values) -> dict:
     value = data.get(name)
     if not (isinstance(value, dict) and all(isinstance(k, str) and values(v) for k, v in value.items())):
@@ -75,11 +82,16 @@ class UnitRecord:
     # Every array -> sha256 of its attributes (store.attributes_sha256); None in records
     # written before they were recorded.
     attributes: dict[str, str] | None = None
+    # The light groups the unit has rendered, where fewer than its manifest's (`generate
+    # --conditions`); None: all of them (and every record written before a unit could hold fewer).
+    light_groups: tuple[str, ...] | None = None
 
     def to_json(self) -> str:
         data = {"unit": self.unit, "kind": self.kind, "arrays": self.arrays, "seconds": self.seconds}
         if self.attributes is not None:
             data["attributes"] = self.attributes
+        if self.light_groups is not None:
+            data["light_groups"] = list(self.light_groups)
         if self.illuminance_lux is not None:
             data["illuminance_lux"] = self.illuminance_lux
         if self.inset is not None:
@@ -95,16 +107,18 @@ class UnitRecord:
             raise RecordError("unit, kind or seconds")
         arrays = _mapping(data, "arrays", lambda v: isinstance(v, str))
         attributes = None if "attributes" not in data else _mapping(data, "attributes", lambda v: isinstance(v, str))
+        groups = None if "light_groups" not in data else _names(data, "light_groups")
         if kind == PLATE:
             illuminance = None if "illuminance_lux" not in data else _mapping(data, "illuminance_lux", _is_number)
-            return cls(unit, kind, arrays, seconds, illuminance_lux=illuminance, attributes=attributes)
+            return cls(unit, kind, arrays, seconds, illuminance_lux=illuminance, attributes=attributes,
+                       light_groups=groups)
         scale, iou = data.get("inset_scale"), data.get("mask_iou")
         if not (isinstance(scale, int) and not isinstance(scale, bool) and _is_number(iou)):
             raise RecordError("inset_scale or mask_iou")
         inset = InsetTruth(pose=_mapping(data, "pose", _is_number), projected_box_tan=_box(data, "projected_box_tan"),
                            inset_scale=scale, box_tan=_box(data, "box_tan"), mask_iou=iou,
                            bbox_xywh=_box(data, "bbox_xywh"))
-        return cls(unit, kind, arrays, seconds, inset=inset, attributes=attributes)
+        return cls(unit, kind, arrays, seconds, inset=inset, attributes=attributes, light_groups=groups)
 
 
 def resolved_content_sha256(resolved: dict) -> str:
@@ -116,7 +130,9 @@ def resolved_content_sha256(resolved: dict) -> str:
 class ResolvedManifest:
     """``manifest.resolved.yaml``: the manifest as run and what its making recorded.
 
-    The four last fields are absent (None) in collections made before they were recorded."""
+    The four fields after ``plan`` are absent (None) in collections made before they were
+    recorded; ``light_groups`` is absent where the collection holds every light group of its
+    manifest."""
 
     package_version: str | None  # of metricscenes, when it was written
     manifest_sha256: str
@@ -130,14 +146,18 @@ class ResolvedManifest:
     content_sha256: str | None = None  # over all of the above (resolved_content_sha256)
     # Every array (masks too) -> sha256 of its attributes (store.attributes_sha256).
     attributes_sha256: dict[str, str] | None = None
+    # The light groups rendered, where fewer than the manifest's (`generate --conditions`).
+    light_groups: list[str] | None = None
 
     def as_dict(self) -> dict:
         """The file's mapping, in the file's order; fields that are None are left out."""
         data = {"package_version": self.package_version, "manifest_sha256": self.manifest_sha256,
-                "manifest": self.manifest_json, "render_variant": self.render_variant, "arrays": self.arrays,
+                "manifest": self.manifest_json, "render_variant": self.render_variant,
+                "light_groups": self.light_groups, "arrays": self.arrays,
                 "attributes_sha256": self.attributes_sha256, "illuminance_lux": self.illuminance_lux,
                 "plan": self.plan, "groundtruth_sha256": self.groundtruth_sha256, "content_sha256": self.content_sha256}
-        optional = ("package_version", "render_variant", "attributes_sha256", "groundtruth_sha256", "content_sha256")
+        optional = ("package_version", "render_variant", "light_groups", "attributes_sha256", "groundtruth_sha256",
+                    "content_sha256")
         return {k: v for k, v in data.items() if v is not None or k not in optional}
 
     def to_yaml(self) -> str:
@@ -151,4 +171,5 @@ class ResolvedManifest:
                    manifest_json=data["manifest"], arrays=data["arrays"],
                    illuminance_lux=data.get("illuminance_lux", {}), plan=data.get("plan", []),
                    render_variant=data.get("render_variant"), groundtruth_sha256=data.get("groundtruth_sha256"),
-                   content_sha256=data.get("content_sha256"), attributes_sha256=data.get("attributes_sha256"))
+                   content_sha256=data.get("content_sha256"), attributes_sha256=data.get("attributes_sha256"),
+                   light_groups=data.get("light_groups"))

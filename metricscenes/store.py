@@ -13,7 +13,8 @@ Layout of a collection folder::
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, the Mitsuba variant that
-                                        rendered it, sha256 of every array (masks too) and of its
+                                        rendered it, the light groups it holds where fewer than the
+                                        manifest's, sha256 of every array (masks too) and of its
                                         attributes, of groundtruth.json and of its own content
     progress/<unit>.json                one record per finished unit of work (resume)
     progress/manifest_sha256            what the records were made from (a resume of another
@@ -24,7 +25,10 @@ The resolved manifest and the progress records are typed in :mod:`metricscenes.r
 Array attributes carry ``units``, ``wavelengths_nm``, ``extent_tan`` (x0, y0, x1, y1)
 and ``light_group``. A light group that puts no light in a unit (e.g. street lights
 on a road without any) has no array: it reads as zero. Which arrays a unit has is
-what ``manifest.resolved.yaml`` records, never what the folder happens to hold.
+what ``manifest.resolved.yaml`` records, never what the folder happens to hold. A
+collection may hold some of its manifest's light groups only (``generate --conditions``;
+:attr:`Collection.light_groups`): a condition that mixes another is refused, in one line
+that says how to add it (:meth:`Collection.check_condition`), never read as zero.
 
 Codecs (:mod:`metricscenes.writer`): radiance is stored losslessly with zarr v3 core
 codecs unless the manifest asks for ``store: {mantissa_bits: N}``; zarr reads each array's
@@ -58,7 +62,7 @@ import yaml
 from metricscenes.geometry import TanExtent, field_extent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.manifest import (
-    Manifest, ManifestError, TargetedCondition, canonical_sha256, illuminance_condition, manifest_sha256,
+    Manifest, ManifestError, TargetedCondition, canonical_sha256, load_manifest, manifest_sha256,
     parse_illuminance_condition, parse_manifest,
 )
 from metricscenes.radiance import RadianceLayer, SpectralScene, car_sharpness, on_grid_of
@@ -331,19 +335,59 @@ class Collection:
     @property
     def condition_names(self) -> list[str]:
         """The manifest's conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
-        sweep = self.manifest.illuminance_sweep
-        levels = [illuminance_condition(sweep.base, lux) for lux in sweep.levels_lux] if sweep else []
-        return list(self.conditions) + levels
+        return self.manifest.condition_names
 
-    def _weights(self, condition: str | dict[str, float], scene_id: str) -> dict[str, float]:
-        """Light-group weights of a condition in one scene (a targeted condition's depend on
-        the scene: :meth:`targeted_weights`)."""
-        if not isinstance(condition, str):
-            return dict(condition)
-        if condition not in self.condition_names:
+    @property
+    def light_groups(self) -> tuple[str, ...]:
+        """The light groups the collection holds: all of its manifest's, or those that
+        ``generate --conditions`` rendered (collections made before it hold all)."""
+        held = self.resolved.light_groups
+        return self.manifest.light_groups if held is None else tuple(g for g in self.manifest.light_groups if g in held)
+
+    @property
+    def held_condition_names(self) -> list[str]:
+        """The conditions (:attr:`condition_names`) whose light groups the collection holds."""
+        return [c for c in self.condition_names if not self._missing_light_groups(c)]
+
+    def _missing_light_groups(self, condition: str | dict[str, float]) -> list[str]:
+        if isinstance(condition, str):
+            needed = self.manifest.condition_light_groups(condition)
+        else:  # (a group the manifest does not render reads as zero, as it always did)
+            needed = [g for g, w in condition.items() if w != 0.0 and g in self.manifest.light_groups]
+        return [g for g in needed if g not in self.light_groups]
+
+    def check_condition(self, condition: str | dict[str, float]) -> None:
+        """Refuse (:class:`CollectionError`, one line) a condition that cannot be mixed here:
+        an unknown name, or one that mixes light groups the collection does not hold (the
+        line names them and the command that renders them)."""
+        if isinstance(condition, str) and condition not in self.condition_names:
             raise CollectionError(
                 f"unknown condition {condition!r} (this collection has: {', '.join(self.condition_names)})"
             )
+        missing = self._missing_light_groups(condition)
+        if missing:
+            add = f"--conditions {condition}" if isinstance(condition, str) else f"--light-groups {','.join(missing)}"
+            raise CollectionError(
+                f"{self.root} holds no {', '.join(missing)} (rendered: {', '.join(self.light_groups)}); add "
+                f"{'it' if len(missing) == 1 else 'them'} with: {self.generate_command()} {add}")
+
+    def generate_command(self) -> str:
+        """The ``metricscenes generate`` command that renders into this collection: with the
+        manifest file in ``manifests/`` of the working directory that holds its manifest (the
+        presets), else with a placeholder for it (the collection keeps the manifest, not its path)."""
+        preset = Path("manifests") / f"{self.name}.yaml"
+        try:
+            manifest = str(preset) if load_manifest(preset).sha256() == self.manifest_sha256 else "<its manifest>"
+        except ManifestError:
+            manifest = "<its manifest>"
+        return f"metricscenes generate --manifest {manifest} --out {self.root}"
+
+    def _weights(self, condition: str | dict[str, float], scene_id: str) -> dict[str, float]:
+        """Light-group weights of a condition in one scene (a targeted condition's depend on
+        the scene: :meth:`targeted_weights`); :meth:`check_condition` refuses one it cannot mix."""
+        self.check_condition(condition)
+        if not isinstance(condition, str):
+            return dict(condition)
         if isinstance(self.conditions.get(condition), TargetedCondition):
             return self.targeted_weights(scene_id, condition).weights
         if condition in self.conditions:
@@ -388,6 +432,7 @@ class Collection:
     def targeted_weights(self, scene_id: str, condition: str) -> TargetedWeights:
         """A targeted condition's weights in one scene: its environment's target drawn from
         the condition's range, the ambient weight that meets it (:mod:`metricscenes.targets`)."""
+        self.check_condition(condition)  # (before its groups are read one by one: the line names the condition)
         spec = self.conditions[condition]
         env = self._image(scene_id)["environment_id"]
         target = draw_target_lux(self.manifest.seed, env, condition, spec.target_image_plane_lux)
@@ -640,6 +685,9 @@ def _load_resolved(root: Path) -> ResolvedManifest:
     if attributes is not None and not (isinstance(attributes, dict)
                                        and all(isinstance(v, str) for v in attributes.values())):
         raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: attributes_sha256 is not a mapping of hashes")
+    groups = resolved.get("light_groups")  # absent where the collection holds all of its manifest's
+    if groups is not None and not (isinstance(groups, list) and all(isinstance(g, str) for g in groups)):
+        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: light_groups is not a list of light groups")
     return ResolvedManifest.from_dict(resolved)
 
 

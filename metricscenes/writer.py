@@ -281,9 +281,10 @@ class CollectionWriter:
 
     # --- the collection's own files, last ----------------------------------------------
     def finish(self, manifest: Manifest, scenes: list[ScenePlan], records: dict[str, UnitRecord],
-               variant: str) -> None:
+               variant: str, light_groups: tuple[str, ...] | None = None) -> None:
         """Write ``groundtruth.json`` and then ``manifest.resolved.yaml`` from the records of
-        all units (every one finished): the collection is complete when the latter lands."""
+        all units (every one finished, each holding ``light_groups``; None: all of the
+        manifest's): the collection is complete when the latter lands."""
         from metricscenes import __version__
         from metricscenes.groundtruth import coco_groundtruth
 
@@ -307,6 +308,7 @@ class CollectionWriter:
             manifest_sha256=manifest.sha256(),
             manifest_json=manifest.model_dump(mode="json"),
             render_variant=variant,
+            light_groups=None if light_groups is None else list(light_groups),
             arrays={path: sha for key in sorted(records) for path, sha in sorted(records[key].arrays.items())},
             # (None if a record predates them: generate records them first, so this is for callers of old records)
             attributes_sha256=None if any(r.attributes is None for r in records.values()) else {

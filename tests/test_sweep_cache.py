@@ -50,6 +50,10 @@ class FakeCollection:
     def condition_record(self, scene_id, condition):  # fixed-weight conditions only
         return None
 
+    def check_condition(self, condition):  # every light group is held
+        if condition not in self.condition_names:
+            raise ValueError(f"unknown condition {condition!r}")
+
 
 class BlankCollection(FakeCollection):
     """A FakeCollection for the real run_camera with ``simulate`` replaced: no radiance."""

@@ -45,6 +45,15 @@ def unknown_condition(condition: str, known) -> str:
     return f"unknown condition {condition!r} (this collection has: {', '.join(known)}){did_you_mean(condition, known)}"
 
 
+def check_condition(collection, condition: str) -> None:
+    """Refuse, in one line and before any work, a condition the collection lacks, or one whose
+    light groups it does not hold (rendered with `generate --conditions`: the line says how to
+    add them; :meth:`metricscenes.store.Collection.check_condition`)."""
+    if condition not in collection.condition_names:
+        fail(unknown_condition(condition, collection.condition_names))
+    collection.check_condition(condition)
+
+
 def camera_text(camera: dict) -> str:
     """MTF50 in both units, focal length and field of view of a results.json ``camera`` ("" for
     a record without them)."""
@@ -95,8 +104,7 @@ def run(
         policy = parse_exposure(exposure) if exposure is not None else None
         cam = with_exposure(load_camera(camera), policy)
         col = subset_collection(Collection.open(collection), environments, distances)
-        if condition not in col.condition_names:
-            fail(unknown_condition(condition, col.condition_names))
+        check_condition(col, condition)
         detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map, model_dir=model_dir)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
@@ -167,10 +175,8 @@ def sweep(
         cams = [load_camera(name) for name in names]
         col = subset_collection(Collection.open(collection), environments, distances)
         conds = [c.strip() for c in conditions.split(",") if c.strip()]
-        known = col.condition_names
         for condition in conds:
-            if condition not in known:
-                fail(unknown_condition(condition, known))
+            check_condition(col, condition)
         if mtf_source not in sweep_module.MTF50_SOURCES:
             fail(f"--mtf-source must be one of {', '.join(sweep_module.MTF50_SOURCES)}, got {mtf_source!r}")
         if not runs_in_process(workers, scheduler):  # each worker loads the detector again, with its share of the CPUs
