@@ -12,7 +12,15 @@ temporaries with the fixed pattern drawn per capture, colour-demosaicing's float
 Malvar); the best time of each is reported, with the load average, since the
 development machine is shared. ``--reference`` adds the plain per-band irradiance
 path (31 forward + 31 inverse FFTs, then spectral integration). A naive per-band
-spatial convolution with the Airy PSF is timed too (two bands, scaled to 31).
+spatial convolution with the lens's PSF is timed too (two bands, scaled to 31).
+``--lenses`` times the optics stage for other lenses of the same camera: Zernike
+defocus + spherical (rotationally symmetric: cached half-grid OTFs), astigmatism + coma
+(complex OTFs, computed band by band) and 3 % veiling glare.
+
+The optics stage is the production path: the lazy optical image
+(:class:`benchmark.camera.optics.OpticalImage`) integrated by the sensor
+(:func:`benchmark.camera.sensor.electron_rate`). Every OTF here, the baseline's table
+and the naive PSF included, comes from :mod:`benchmark.camera.lens`.
 """
 
 from __future__ import annotations
@@ -27,7 +35,7 @@ import numpy as np
 import scipy.fft as sfft
 import scipy.ndimage
 
-from benchmark.camera import calibration, exposure, isp, optics, sensor
+from benchmark.camera import calibration, exposure, isp, lens, optics, sensor
 from benchmark.camera.pipeline import simulate
 from benchmark.camera import load_camera
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
@@ -70,7 +78,8 @@ def old_resample(scene: SpectralScene, cols: int, rows: int) -> np.ndarray:
     return out
 
 
-_TABLE = optics.diffraction_mtf(np.linspace(0.0, 1.0, 16385), 1.0, 1e6).astype(np.float32)
+# the ideal lens's OTF H(ν / ν_c) tabulated over ν / ν_c in [0, 1] (λ N = 1 mm: ν_c = 1 cy/mm)
+_TABLE = lens.diffraction_otf(np.linspace(0.0, 1.0, 16385), 1e6, 1.0).astype(np.float32)
 
 
 def old_channel_signal(radiance, wavelengths_nm, opt, pixel_um, responsivity):
@@ -138,7 +147,15 @@ def _pair(new, old, repeat: int) -> tuple[float, float, object, object]:
     return t_new, t_old, out_new, out_old
 
 
-def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool) -> None:
+LENSES = (
+    ("Zernike defocus 0.2 + spherical 0.05 waves", {"zernike_waves": ((4, 0.2), (12, 0.05))}),
+    ("Zernike astigmatism 0.15 + coma 0.1 waves", {"zernike_waves": ((5, 0.15), (8, 0.1))}),
+    ("veiling glare 3 %", {"veiling_glare_fraction": 0.03}),
+)
+"""Other lenses timed by ``--lenses`` (the camera's lens with these fields changed)."""
+
+
+def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool, lenses: bool = False) -> None:
     cam = load_camera(name)
     rows, cols = cam.height_px, cam.width_px
     resp = sensor.channel_responsivity(cam.sensor)
@@ -148,7 +165,7 @@ def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool) 
     t, t0, rad, rad_old = _pair(lambda: scene.resample(cols, rows), lambda: old_resample(scene, cols, rows), repeat)
     rows_out.append(("resample", t, t0))
     t, t0, chans, chans_old = _pair(
-        lambda: optics.channel_signal(rad, WAVELENGTHS_NM, cam.optics, cam.pixel_um, resp),
+        lambda: sensor.electron_rate(optics.OpticalImage(rad, WAVELENGTHS_NM, cam.pixel_um, cam.optics), cam.sensor),
         lambda: old_channel_signal(rad_old, WAVELENGTHS_NM, cam.optics, cam.pixel_um, resp),
         repeat,
     )
@@ -180,8 +197,14 @@ def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool) 
           f"channels max rel {np.abs(chans - chans_old).max() / chans_old.max():.1e}, "
           f"linear sRGB max abs {np.abs(lin - lin_old).max():.1e}")
     t_naive = naive_convolution_s(rad, cam)
-    print(f"naive baseline, per-band spatial convolution with the Airy PSF (2 bands timed, x31/2): "
+    print(f"naive baseline, per-band spatial convolution with the lens's PSF (2 bands timed, x31/2): "
           f"{t_naive:.1f} s = {t_naive / rows_out[1][1]:.0f}x the optics")
+    if lenses:
+        for label, update in LENSES:
+            other = cam.optics.model_copy(update=update)
+            t_lens, _, _, _ = _pair(lambda: sensor.electron_rate(optics.OpticalImage(rad, WAVELENGTHS_NM, cam.pixel_um,
+                                                                                     other), cam.sensor), None, repeat)
+            print(f"optics, {label:<44}{t_lens:>7.3f} s ({t_lens / rows_out[1][1]:.1f}x the ideal lens)")
     if reference:
         t_ref, _, _, _ = _pair(
             lambda: np.einsum("hwb,cb->chw", optics.irradiance(rad, WAVELENGTHS_NM, cam.optics, cam.pixel_um),
@@ -189,20 +212,25 @@ def bench_camera(name: str, scene: SpectralScene, repeat: int, reference: bool) 
         print(f"reference per-band irradiance + integration: {t_ref:.3f} s ({t_ref / rows_out[1][1]:.1f}x the optics)")
 
 
-def naive_convolution_s(radiance: np.ndarray, cam) -> float:
-    """Seconds a naive optics stage would take: each band convolved in space with its
-    Airy PSF (sampled at the pixel pitch out to 3 first-zero radii), timed on two bands
-    (the shortest and longest wavelength) and scaled to 31."""
-    from scipy.special import j1
+def lens_psf(cam, wavelength_nm: float, radius_px: int) -> np.ndarray:
+    """The camera's lens PSF sampled at its pixel pitch over ±``radius_px``, unit sum: the
+    inverse FFT of :func:`benchmark.camera.lens.lens_otf` on that grid."""
+    size = 2 * radius_px + 1
+    pixel_mm = cam.pixel_um * 1e-3
+    otf = lens.lens_otf(cam.optics, wavelength_nm, sfft.fftfreq(size, d=pixel_mm), sfft.fftfreq(size, d=pixel_mm))
+    psf = np.fft.fftshift(np.real(np.fft.ifft2(otf)))
+    return (psf / psf.sum()).astype(np.float32)
 
+
+def naive_convolution_s(radiance: np.ndarray, cam) -> float:
+    """Seconds a naive optics stage would take: each band convolved in space with its lens
+    PSF (:func:`lens_psf`, out to 3 first-zero radii of the Airy pattern), timed on two
+    bands (the shortest and longest wavelength) and scaled to 31."""
     spent = 0.0
     for band in (0, len(WAVELENGTHS_NM) - 1):
         lam_um = WAVELENGTHS_NM[band] * 1e-3
         radius_px = int(np.ceil(3 * 1.22 * lam_um * cam.f_number / cam.pixel_um))
-        r = np.hypot(*np.mgrid[-radius_px:radius_px + 1, -radius_px:radius_px + 1]) * cam.pixel_um
-        x = np.pi * r / (lam_um * cam.f_number)
-        psf = np.where(x > 0, (2 * j1(x) / np.where(x > 0, x, 1)) ** 2, 1.0)
-        psf = (psf / psf.sum()).astype(np.float32)
+        psf = lens_psf(cam, float(WAVELENGTHS_NM[band]), radius_px)
         plane = np.ascontiguousarray(radiance[..., band])
         t = time.perf_counter()
         scipy.ndimage.convolve(plane, psf, mode="reflect")
@@ -215,12 +243,13 @@ def main() -> None:
     parser.add_argument("--cameras", nargs="+", default=["cam10", "cam08"])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--reference", action="store_true", help="also time the per-band irradiance path")
+    parser.add_argument("--lenses", action="store_true", help="also time the optics of aberrated and glaring lenses")
     args = parser.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, numpy {np.__version__}, "
           f"load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     scene = two_layer_scene()
     for name in args.cameras:
-        bench_camera(name, scene, args.repeat, args.reference)
+        bench_camera(name, scene, args.repeat, args.reference, args.lenses)
 
 
 if __name__ == "__main__":

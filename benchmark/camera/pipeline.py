@@ -2,8 +2,8 @@
 
 ``simulate(scene, camera, seed=...)`` is what ``benchmark run`` calls for every scene:
 
-    radiance (resampled to the pixel grid) ──optics──▶ electron-rate per channel
-    ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
+    radiance (resampled to the pixel grid) ──lens──▶ optical image ──sensor QE──▶
+    electron-rate per channel ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
 
 The ``hdr`` exposure policy captures a long and a short raw and merges them before the
 ISP (:mod:`benchmark.camera.hdr`), then tone-maps before the sRGB encoding.
@@ -124,22 +124,19 @@ def electron_rate(
     extent: TanExtent | None = None,
     diffraction: bool = True,
 ) -> np.ndarray:
-    """Noise-free signal, electrons·s⁻¹, per channel (3, rows, cols).
+    """Noise-free signal, electrons·s⁻¹, per channel (3, rows, cols): the scene's optical
+    image (:func:`optical_image`) through the sensor, which integrates its own QE
+    (:func:`benchmark.camera.sensor.electron_rate`, the fast path).
 
     ``shape_px`` (rows, cols) and ``extent`` select a window of the sensor (default:
     the full frame: the camera's own field, :func:`camera_window` of the scene's
     field); the window must be sampled at the camera's pixel pitch. With lens
     distortion ``extent`` is in the sensor's (distorted) coordinates and the scene is
     sampled through the distortion (:func:`benchmark.camera.distortion.resample_distorted`).
+    ``diffraction`` off: no lens blur (irradiance only).
     """
-    radiance = sensor_radiance(scene, camera, shape_px=shape_px, extent=extent)
-    # The fused fast path: optics and the sensor's spectral integration in one pass over
-    # the bands (benchmark.camera.optics.channel_signal); optical_image + the sensor's
-    # signal_from_irradiance is the plain path it is held equal to (tests/test_camera_speed_paths.py).
-    resp = _sensor.channel_responsivity(camera.sensor, np.asarray(scene.wavelengths_nm, float))
-    return _optics.channel_signal(
-        radiance, scene.wavelengths_nm, camera.optics, camera.pixel_um, resp, diffraction=diffraction
-    )
+    oi = optical_image(scene, camera, shape_px=shape_px, extent=extent, diffraction=diffraction)
+    return _sensor.electron_rate(oi, camera.sensor)
 
 
 def sensor_radiance(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple[int, int] | None = None,
@@ -160,11 +157,13 @@ def sensor_radiance(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple
     return radiance
 
 
-def optical_image(scene: SpectralScene, camera: CameraSpec, *, diffraction: bool = True) -> _optics.OpticalImage:
-    """The scene through the camera's lens: spectral irradiance on its pixel grid (the
-    plain path, band by band; :func:`electron_rate` fuses it with the sensor)."""
-    return _optics.optical_image(sensor_radiance(scene, camera), scene.wavelengths_nm, camera.optics,
-                                 camera.pixel_um, diffraction=diffraction)
+def optical_image(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple[int, int] | None = None,
+                  extent: TanExtent | None = None, diffraction: bool = True) -> _optics.OpticalImage:
+    """The scene through the camera's lens: the (lazy) optical image on its pixel grid, or
+    the window ``shape_px``, ``extent`` of it (as :func:`electron_rate`): the radiance
+    resampled there and the lens; its irradiance is computed when asked for."""
+    return _optics.optical_image(sensor_radiance(scene, camera, shape_px=shape_px, extent=extent), scene.wavelengths_nm,
+                                 camera.optics, camera.pixel_um, diffraction=diffraction)
 
 
 def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool = True) -> Capture:

@@ -67,11 +67,20 @@ def channel_responsivity(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELE
     return effective_qe(sensor, wavelengths_nm) * photons_per_j[None, :] * BAND_WIDTH_NM * area
 
 
+def electron_rate(optical_image, sensor: SensorSpec) -> np.ndarray:
+    """Noise-free signal per channel (3, rows, cols), electrons·s⁻¹, of an optical image
+    (:class:`benchmark.camera.optics.OpticalImage`): the sensor integrates its own QE,
+    Σ_λ r_c(λ)·E(λ) with :func:`channel_responsivity`, asking the optical image for those
+    weighted sums of its bands (:meth:`~benchmark.camera.optics.OpticalImage.weighted_sum`,
+    the fast path; :func:`signal_from_irradiance` is the plain one it is held equal to)."""
+    return optical_image.weighted_sum(channel_responsivity(sensor, np.asarray(optical_image.wavelengths_nm, float)))
+
+
 def signal_from_irradiance(irradiance: np.ndarray, wavelengths_nm: np.ndarray, sensor: SensorSpec) -> np.ndarray:
     """Noise-free signal per channel (3, rows, cols), electrons·s⁻¹, of a spectral
     irradiance (rows, cols, bands) in W·m⁻²·nm⁻¹ (an optical image's): Σ_λ r_c(λ)·E(λ)
-    with :func:`channel_responsivity`. The plain path; the camera's fused fast path
-    (``benchmark.camera.optics.channel_signal``) is held equal to it."""
+    with :func:`channel_responsivity`. The plain path; :func:`electron_rate` (the
+    camera's fast path) is held equal to it."""
     resp = channel_responsivity(sensor, np.asarray(wavelengths_nm, float))
     return np.einsum("hwb,cb->chw", np.asarray(irradiance, np.float64), resp).astype(np.float32)
 

@@ -14,10 +14,18 @@ are square in angle by construction (docs/camera.md, "Field of view and geometry
 
 A spec is validated as a whole (docs/camera.md, "Refused specs"): black level below the
 ADC white level, a ``qe`` file that is packaged or lies beside the spec file and holds a
-physically possible table (:func:`check_qe_table`), a known illuminant, a pixel array of
-at least 16 × 16 and at most :data:`MAX_CAPTURE_GIB` of memory for one capture. Values
-no sensor has are refused with the unit mistake they most likely are, and unusual but
-possible ones are warned about (:data:`PLAUSIBLE`, docs/camera.md, "Plausible values").
+physically possible table (:func:`check_qe_table`), lens tables (``optics.psf_table``,
+``optics.mtf_table``) beside the spec file that :mod:`benchmark.camera.lens` can read and
+that sample the pixel grid finely enough, Zernike indices it knows, a known illuminant, a
+pixel array of at least 16 × 16 and at most :data:`MAX_CAPTURE_GIB` of memory for one
+capture. Values no sensor has are refused with the unit mistake they most likely are, and
+unusual but possible ones are warned about (:data:`PLAUSIBLE`, docs/camera.md, "Plausible
+values").
+
+Specs that can grow: a field added after the registry and its leaderboard is declared with
+:func:`added_later`, and one rule (:class:`SpecModel`) leaves it out of the serialisation —
+hence out of :meth:`CameraSpec.sha256` — wherever it is at its default, so every earlier
+spec keeps its bytes (docs/camera.md, "Adding a camera feature").
 """
 
 from __future__ import annotations
@@ -36,19 +44,22 @@ from pydantic import (
     PrivateAttr,
     ValidationInfo,
     computed_field,
+    field_serializer,
     field_validator,
     model_serializer,
     model_validator,
 )
 
+from benchmark.camera import lens as _lens
 from benchmark.camera.distortion import check_monotonic, undistorted_bounds
+from benchmark.camera.tables import TABLE_WAVELENGTH_RANGE_NM, check_wavelengths_nm, read_numeric_csv
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
     REFERENCE_ACTIVE_WIDTH_MM,
     REFERENCE_FOCAL_LENGTH_MM,
     TanExtent,
 )
-from metricscenes.spectral import SENSOR_DATA_DIR
+from metricscenes.spectral import SENSOR_DATA_DIR, WAVELENGTHS_NM
 
 _STRICT = ConfigDict(extra="forbid", frozen=True)
 
@@ -75,20 +86,23 @@ SPEC_DIR_CONTEXT = "spec_dir"
 """Validation context key: the folder of the spec file (``qe`` user files resolve there)."""
 
 
-def _check_qe_syntax(value: str) -> str:
-    """``qe`` must be a relative POSIX path of a ``.csv`` inside its folder: no absolute
-    path or drive, no ``..``, no backslash, NUL or line break."""
+def _check_relative_csv(value: str, columns: str, packaged: str = "") -> str:
+    """A user table's path must be a relative POSIX path of a ``.csv`` inside its folder: no
+    absolute path or drive, no ``..``, no backslash, NUL or line break."""
     bad = next((c for c in ("\\", "\0", "\n", "\r") if c in value), None)
     if bad is not None:
         raise ValueError(f"a relative path with '/' separators is expected, without {bad!r}")
     if PurePosixPath(value).is_absolute() or PureWindowsPath(value).drive or value.startswith("~"):
-        raise ValueError("an absolute path is refused: name a packaged file (imx363_qe.csv) or a file "
-                         "beside the spec file")
+        raise ValueError(f"an absolute path is refused: name {packaged}a file beside the spec file")
     if ".." in PurePosixPath(value).parts:
         raise ValueError("'..' is refused: the file must lie in the spec file's folder or below it")
     if PurePosixPath(value).suffix.lower() != ".csv":
-        raise ValueError("a .csv file is expected (columns wavelength_nm, qe_r, qe_g, qe_b)")
+        raise ValueError(f"a .csv file is expected (columns {columns})")
     return value
+
+
+def _check_qe_syntax(value: str) -> str:
+    return _check_relative_csv(value, "wavelength_nm, qe_r, qe_g, qe_b", packaged="a packaged file (imx363_qe.csv) or ")
 
 
 @dataclass(frozen=True)
@@ -170,7 +184,7 @@ def plausibility_warnings(camera: "CameraSpec") -> list[str]:
     return out
 
 
-QE_WAVELENGTH_RANGE_NM = (200.0, 1200.0)
+QE_WAVELENGTH_RANGE_NM = TABLE_WAVELENGTH_RANGE_NM
 """Where a silicon sensor's QE table may lie, nm (wavelengths in µm are refused with that hint)."""
 
 
@@ -180,51 +194,32 @@ def check_qe_table(path: str | Path) -> tuple:
     rows, every value a finite number, wavelengths strictly increasing within
     :data:`QE_WAVELENGTH_RANGE_NM`, QE and transmittance between 0 and 1 (a fraction of the
     photons). Else a one-line ValueError naming the file, the row and the column."""
-    import warnings
-
     import numpy as np
 
     name = Path(path).name
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # an empty or short file: refused below, one line
-            table = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"QE table {name}: unreadable ({str(exc).splitlines()[0]})") from None
-    names = table.dtype.names or ()
-    missing = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b") if c not in names]
-    if missing:
-        raise ValueError(f"QE table {name}: lacks column(s) {', '.join(missing)} "
-                         "(expected wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance])")
-    if table.size < 2:
-        raise ValueError(f"QE table {name}: {table.size} row(s); two or more wavelengths are needed")
-    columns = [c for c in ("wavelength_nm", "qe_r", "qe_g", "qe_b", "ir_cut_transmittance") if c in names]
-    for column in columns:
-        values = np.asarray(table[column], float)
-        bad = np.nonzero(~np.isfinite(values))[0]
-        if bad.size:
-            raise ValueError(f"QE table {name}: row {bad[0] + 1} {column} is not a number")
-    wl = np.asarray(table["wavelength_nm"], float)
+    columns = ("wavelength_nm", "qe_r", "qe_g", "qe_b")
+    table = read_numeric_csv(path, "QE table", columns, optional=("ir_cut_transmittance",),
+                             expected="wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]")
+    rows = table["wavelength_nm"].size
+    if rows < 2:
+        raise ValueError(f"QE table {name}: {rows} row(s); two or more wavelengths are needed")
+    wl = table["wavelength_nm"]
     step = np.nonzero(np.diff(wl) <= 0)[0]
     if step.size:
         i = step[0]
         raise ValueError(f"QE table {name}: wavelength_nm must increase row by row: row {i + 2} ({wl[i + 1]:g}) "
                          f"follows row {i + 1} ({wl[i]:g})")
-    lo, hi = QE_WAVELENGTH_RANGE_NM
-    if wl[0] < lo or wl[-1] > hi:
-        hint = f"; if they are in um, write {wl[0] * 1000:g} to {wl[-1] * 1000:g}" if wl[-1] < 10 else ""
-        raise ValueError(f"QE table {name}: wavelengths {wl[0]:g} to {wl[-1]:g} nm lie outside {lo:g} to {hi:g} nm{hint}")
-    for column in columns[1:]:
-        values = np.asarray(table[column], float)
+    check_wavelengths_nm(wl, "QE table", name)
+    for column in list(table)[1:]:
+        values = table[column]
         outside = np.nonzero((values < 0) | (values > 1))[0]
         if outside.size:
             i = outside[0]
             hint = "; if the table is in percent, divide it by 100" if 0 <= values.min() and values.max() <= 100 else ""
             raise ValueError(f"QE table {name}: row {i + 1} {column} is {values[i]:g}: a fraction of the photons, "
                              f"between 0 and 1{hint}")
-    qe = np.stack([np.asarray(table[f"qe_{c}"], float) for c in ("r", "g", "b")])
-    ir = np.asarray(table["ir_cut_transmittance"], float) if "ir_cut_transmittance" in names else None
-    return wl, qe, ir
+    qe = np.stack([table[f"qe_{c}"] for c in ("r", "g", "b")])
+    return wl, qe, table.get("ir_cut_transmittance")
 
 
 def packaged_qe(name: str) -> Path | None:
@@ -235,20 +230,149 @@ def packaged_qe(name: str) -> Path | None:
     return path if path.is_file() else None
 
 
-class OpticsSpec(BaseModel):
-    """Diffraction-limited lens (circular pupil, no aberrations)."""
+ADDED_LATER = "added_later"
+"""Marks (in ``json_schema_extra``) a field declared with :func:`added_later`."""
+
+
+def added_later(default, **constraints):
+    """A spec field added after the registry and its leaderboard (a ``Field`` with
+    ``default`` and its ``constraints``): :class:`SpecModel` writes it only where it is
+    not at its default, so every spec written before it keeps its canonical JSON, hence
+    its sha256 (docs/camera.md, "Adding a camera feature")."""
+    return Field(default, json_schema_extra={ADDED_LATER: True}, **constraints)
+
+
+class SpecModel(BaseModel):
+    """A part of a camera spec (frozen, no unknown keys), serialised by the one rule for
+    specs that grow: a field declared with :func:`added_later` is left out wherever it
+    is at its default."""
 
     model_config = _STRICT
+
+    @model_serializer(mode="wrap")
+    def _omit_later_fields_at_default(self, handler):
+        data = handler(self)
+        if isinstance(data, dict):
+            for name, field in type(self).model_fields.items():
+                extra = field.json_schema_extra
+                if isinstance(extra, dict) and extra.get(ADDED_LATER) and getattr(self, name) == field.default:
+                    data.pop(name, None)
+        return data
+
+
+PSF_TABLE_COLUMNS = ", ".join(_lens.PSF_COLUMNS)
+MTF_TABLE_COLUMNS = ", ".join(_lens.MTF_COLUMNS)
+
+
+class OpticsSpec(SpecModel):
+    """The lens: focal length, f-number, transmittance, relative illumination, distortion,
+    and what forms its image (:mod:`benchmark.camera.lens`): a diffraction-limited
+    circular pupil (the default), the same pupil with Zernike aberrations, or a measured
+    PSF or MTF table; optionally veiling glare."""
 
     focal_length_mm: float = Field(REFERENCE_FOCAL_LENGTH_MM, gt=0.5, le=100.0)
     f_number: float = Field(..., ge=0.5, le=64.0)
     transmittance: float = Field(1.0, gt=0.0, le=1.0)
     cos4_falloff: bool = False
-    distortion_k1: float = Field(0.0, ge=-1.0, le=1.0)
+    distortion_k1: float = added_later(0.0, ge=-1.0, le=1.0)
     """Brown–Conrady radial distortion, r² term (normalised image coordinates x/f;
     negative: barrel), :mod:`benchmark.camera.distortion`."""
-    distortion_k2: float = Field(0.0, ge=-1.0, le=1.0)
+    distortion_k2: float = added_later(0.0, ge=-1.0, le=1.0)
     """Brown–Conrady radial distortion, r⁴ term."""
+    zernike_waves: tuple[tuple[int, float], ...] = added_later(())
+    """Wavefront aberration: a mapping OSA/ANSI index j → coefficient in waves (RMS, unit-RMS
+    polynomials) at ``zernike_wavelength_nm``, e.g. ``{4: 0.25}`` (defocus), 12 primary
+    spherical, 3/5 astigmatism, 7/8 coma (:func:`benchmark.camera.lens.zernike`). Held as
+    sorted (j, c) pairs without zeros: all-zero coefficients are the ideal lens, bit for bit."""
+    zernike_wavelength_nm: float = added_later(550.0, ge=300.0, le=1100.0)
+    """The wavelength at which ``zernike_waves`` are given (the wavefront, an optical path
+    difference, is the same at every wavelength: fewer waves at longer ones)."""
+    psf_table: str | None = added_later(None, min_length=1, max_length=255)
+    """A measured PSF per wavelength: a CSV beside the spec file (relative path), columns
+    ``wavelength_nm, x_um, y_um, psf`` (:func:`benchmark.camera.lens.read_psf_table`)."""
+    mtf_table: str | None = added_later(None, min_length=1, max_length=255)
+    """A measured MTF per wavelength: a CSV beside the spec file, columns
+    ``wavelength_nm, frequency_cy_per_mm, mtf`` (:func:`benchmark.camera.lens.read_mtf_table`)."""
+    veiling_glare_fraction: float = added_later(0.0, ge=0.0, le=0.5)
+    """Fraction of the light that veiling glare spreads over the image (0: none); the veiling
+    glare index of ISO 9358:1994 measures it (docs/camera.md, "The lens")."""
+    glare_angle_deg: float = added_later(0.1, gt=0.0, le=10.0)
+    """Scale angle θ₀ of the glare spread function (1 + (θ/θ₀)²)^(-3/2): 0.1°, the scale
+    angle of the wide-angle terms of the CIE 146:2002 general disability glare equation."""
+
+    _table_path: str | None = PrivateAttr(None)
+    """The resolved PSF or MTF table (a spec loaded from a file); None: unresolved."""
+
+    @field_validator("zernike_waves", mode="before")
+    @classmethod
+    def _zernike_mapping(cls, value):
+        items = value.items() if isinstance(value, dict) else value
+        try:
+            pairs = [(key, coefficient) for key, coefficient in items]
+        except (TypeError, ValueError):
+            raise ValueError("a mapping of OSA/ANSI index j to waves is expected, e.g. {4: 0.25}") from None
+        out = {}
+        for key, coefficient in pairs:
+            text = str(key).strip()
+            if isinstance(key, bool) or not text.lstrip("+-").isdigit():
+                raise ValueError(f"index {key!r} is not an OSA/ANSI Zernike index (an integer j; 4 defocus, "
+                                 "3 and 5 astigmatism, 7 and 8 coma, 12 primary spherical)")
+            j = int(text)
+            if not 1 <= j <= _lens.MAX_ZERNIKE_INDEX:
+                why = " (j = 0 is piston, which changes no image)" if j == 0 else ""
+                raise ValueError(f"index {j} is outside the OSA/ANSI indices 1 to {_lens.MAX_ZERNIKE_INDEX} "
+                                 f"(radial orders 1 to {_lens.MAX_ZERNIKE_ORDER}){why}; Noll indices start at 1 "
+                                 "too but order the terms differently: convert them to OSA/ANSI")
+            if isinstance(coefficient, bool) or not isinstance(coefficient, (int, float)) \
+                    or not math.isfinite(coefficient):
+                raise ValueError(f"index {j}: coefficient {coefficient!r} is not a finite number of waves")
+            if abs(coefficient) > 5.0:
+                raise ValueError(f"index {j}: {coefficient:g} waves is above the 5 waves modelled here (is it in "
+                                 "micrometres or nanometres? coefficients are in waves at zernike_wavelength_nm); "
+                                 "describe so blurred a lens by a PSF table")
+            if j in out:
+                raise ValueError(f"index {j} is given twice")
+            out[j] = float(coefficient)
+        return tuple(sorted((j, c) for j, c in out.items() if c != 0.0))
+
+    @field_serializer("zernike_waves")
+    def _zernike_as_mapping(self, value):
+        return {j: c for j, c in value}
+
+    @field_validator("psf_table", "mtf_table")
+    @classmethod
+    def _table_is_readable(cls, value: str | None, info: ValidationInfo):
+        if value is None:
+            return value
+        columns = PSF_TABLE_COLUMNS if info.field_name == "psf_table" else MTF_TABLE_COLUMNS
+        _check_relative_csv(value, columns)
+        spec_dir = (info.context or {}).get(SPEC_DIR_CONTEXT)
+        if spec_dir is not None:
+            path = Path(spec_dir) / value
+            if not path.is_file():
+                raise ValueError(f"no file {path} (a CSV beside the spec file, columns {columns})")
+            read = _lens.read_psf_table if info.field_name == "psf_table" else _lens.read_mtf_table
+            read(str(path.resolve()))  # a table the lens can use, or refused before anything runs
+        return value
+
+    @model_validator(mode="after")
+    def _one_description_of_the_lens(self, info: ValidationInfo) -> "OpticsSpec":
+        given = [name for name in ("zernike_waves", "psf_table", "mtf_table") if getattr(self, name)]
+        if len(given) > 1:
+            raise ValueError(f"{' and '.join('optics.' + g for g in given)} each describe the whole lens: give one "
+                             "(a measured table already holds the lens's aberrations)")
+        if self.zernike_waves:
+            slope = _lens.wavefront_slope(self.zernike_waves) * self.zernike_wavelength_nm / float(WAVELENGTHS_NM.min())
+            limit = _lens.PUPIL_MAX_SAMPLES / _lens.PUPIL_SAMPLES_PER_SLOPE
+            if slope > limit:
+                raise ValueError(f"optics.zernike_waves: the wavefront's steepest slope, {slope:.3g} waves per pupil "
+                                 f"radius at {WAVELENGTHS_NM.min():g} nm, is above the {limit:g} the pupil sampling "
+                                 "holds: describe so blurred a lens by a PSF table")
+        table = self.psf_table or self.mtf_table
+        spec_dir = (info.context or {}).get(SPEC_DIR_CONTEXT) if info is not None else None
+        if table is not None and spec_dir is not None:
+            self._table_path = str((Path(spec_dir) / table).resolve())
+        return self
 
     @property
     def distortion(self) -> tuple[float, float] | None:
@@ -256,22 +380,29 @@ class OpticsSpec(BaseModel):
         return None if self.distortion_k1 == 0.0 and self.distortion_k2 == 0.0 else (
             self.distortion_k1, self.distortion_k2)
 
-    @model_serializer(mode="wrap")
-    def _omit_zero_distortion(self, handler):
-        # The distortion came after the registry and its leaderboard: written only where
-        # it is not zero, so every earlier spec keeps its canonical JSON, hence its sha256.
-        data = handler(self)
-        if isinstance(data, dict):
-            for key in ("distortion_k1", "distortion_k2"):
-                if data.get(key) == 0.0:
-                    data.pop(key)
-        return data
+    def _table(self, name: str) -> Path:
+        value = getattr(self, name)
+        if value is None:
+            raise ValueError(f"optics.{name}: this lens has none")
+        path = Path(self._table_path) if self._table_path is not None else Path(value)
+        if not path.is_file():
+            raise ValueError(f"optics.{name}: file {value!r} not found (a CSV beside the spec file)")
+        return path
+
+    @property
+    def psf_table_path(self) -> Path:
+        """The PSF table this lens reads: resolved beside the spec file it was loaded from,
+        else ``psf_table`` from the working folder. ValueError if it does not exist."""
+        return self._table("psf_table")
+
+    @property
+    def mtf_table_path(self) -> Path:
+        """The MTF table this lens reads (as :attr:`psf_table_path`)."""
+        return self._table("mtf_table")
 
 
-class SensorSpec(BaseModel):
+class SensorSpec(SpecModel):
     """Sensor geometry, spectral response and noise (IMX363-like defaults, ISETCam)."""
-
-    model_config = _STRICT
 
     pixel_um: float = Field(..., ge=0.2, le=20.0)
     active_width_mm: float = Field(REFERENCE_ACTIVE_WIDTH_MM, gt=0.0, le=50.0)
@@ -395,7 +526,11 @@ class SensorSpec(BaseModel):
         return path
 
 
-class ExposureSpec(BaseModel):
+HDR_DEFAULT_RATIO = 16.0
+"""The ``hdr`` policy's long / short exposure ratio where none is given (``--exposure hdr``)."""
+
+
+class ExposureSpec(SpecModel):
     """Exposure policy (docs/camera.md, "Acquisition policies"). ``auto_peak``: the
     paper's (noise-free peak voltage in the central region at ``level`` of the swing);
     ``mean_level``: the mean voltage of the central region at ``level`` of the swing;
@@ -403,8 +538,6 @@ class ExposureSpec(BaseModel):
     of the swing; ``hdr``: a long and a short exposure ``hdr_ratio`` apart, merged
     before the ISP (:mod:`benchmark.camera.hdr`); ``fixed``: ``exposure_s``. All but ``fixed``
     are capped at ``max_exposure_s``."""
-
-    model_config = _STRICT
 
     mode: Literal["auto_peak", "fixed", "mean_level", "percentile", "hdr"] = "auto_peak"
     level: float = Field(0.90, gt=0.0, le=1.0)
@@ -417,12 +550,20 @@ class ExposureSpec(BaseModel):
     exposure of the whole frame (see docs/camera.md)."""
     max_exposure_s: float = Field(0.016, gt=0.0, le=60.0)
     exposure_s: float = Field(1.0 / 60.0, gt=0.0, le=60.0)
-    percentile: float | None = Field(None, gt=0.0, le=100.0)
+    percentile: float | None = added_later(None, gt=0.0, le=100.0)
     """``percentile`` mode (required there, refused elsewhere): the percentile of the
     central region's noise-free signal put at ``level`` × swing (100: the maximum)."""
-    hdr_ratio: float = Field(16.0, gt=1.0, le=1024.0)
+    hdr_ratio: float | None = added_later(None, gt=1.0, le=1024.0)
     """``hdr`` mode (refused elsewhere): long / short exposure time, fixed, as in the
-    two-frame HDR of automotive sensors."""
+    two-frame HDR of automotive sensors; :data:`HDR_DEFAULT_RATIO` where the mode is
+    ``hdr`` and none is given (so an ``hdr`` spec always records its ratio)."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _hdr_has_a_ratio(cls, data):
+        if isinstance(data, dict) and data.get("mode") == "hdr" and data.get("hdr_ratio") is None:
+            data = {**data, "hdr_ratio": HDR_DEFAULT_RATIO}
+        return data
 
     @field_validator("max_exposure_s", "exposure_s", mode="before")
     @classmethod
@@ -439,27 +580,12 @@ class ExposureSpec(BaseModel):
             raise ValueError(f"'hdr_ratio' applies to mode 'hdr' only, not {self.mode!r}")
         return self
 
-    @model_serializer(mode="wrap")
-    def _omit_fields_of_other_modes(self, handler):
-        # percentile and hdr_ratio came after the registry and its leaderboard: they are
-        # written only for the mode that reads them, so every earlier spec keeps its
-        # canonical JSON, hence its sha256.
-        data = handler(self)
-        if isinstance(data, dict):
-            if self.mode != "percentile":
-                data.pop("percentile", None)
-            if self.mode != "hdr":
-                data.pop("hdr_ratio", None)
-        return data
 
-
-class ISPSpec(BaseModel):
+class ISPSpec(SpecModel):
     """Image processing: demosaic, white balance, colour transform, output encoding.
 
     :func:`isp_preset` names complete settings: ``default`` (this model's defaults) and
     ``iset-parity`` (ISETCam's default image processor, docs/camera.md)."""
-
-    model_config = _STRICT
 
     demosaic: Literal["malvar2004", "bilinear"] = "malvar2004"
     white_balance: Literal["grey_world", "known_illuminant", "none"] = "grey_world"
@@ -480,27 +606,15 @@ class ISPSpec(BaseModel):
             raise ValueError(f"unknown illuminant {value!r} (colour-science names, e.g. D65, A, D50, F2)") from None
         return value
     output: Literal["srgb8", "linear"] = "srgb8"
-    color_transform: Literal["checker_srgb", "iset_mcc"] = "checker_srgb"
+    color_transform: Literal["checker_srgb", "iset_mcc"] = added_later("checker_srgb")
     """``checker_srgb``: the ColorChecker-fitted matrix from white-balanced camera RGB to
     linear sRGB (rows sum to 1; 1.0 = the ADC white). ``iset_mcc``: ISETCam's 'MCC
     optimized' sensor conversion to XYZ, then display rendering scaled to the image's
     maximum (:func:`benchmark.camera.isp.iset_render`)."""
 
-    @model_serializer(mode="wrap")
-    def _omit_default_color_transform(self, handler):
-        # color_transform came after the registry and its leaderboard: it is written only
-        # when it is not the default, so every earlier spec keeps its canonical JSON,
-        # hence its sha256.
-        data = handler(self)
-        if isinstance(data, dict) and self.color_transform == "checker_srgb":
-            data.pop("color_transform", None)
-        return data
 
-
-class CameraSpec(BaseModel):
+class CameraSpec(SpecModel):
     """One camera of the benchmark."""
-
-    model_config = _STRICT
 
     name: str = Field(..., pattern=r"^[A-Za-z0-9_.-]+$", max_length=64)
     label: str = ""
@@ -531,6 +645,30 @@ class CameraSpec(BaseModel):
     def _lens_does_not_fold(self) -> "CameraSpec":
         if self.optics.distortion is not None:
             check_monotonic(*self.optics.distortion, math.hypot(self.tan_half_width, self.tan_half_height))
+        return self
+
+    @model_validator(mode="after")
+    def _lens_table_covers_the_pixel_grid(self) -> "CameraSpec":
+        # A measured lens is read on this sensor's frequency grid: the PSF must be sampled
+        # at least as finely as the pixels (else its Fourier sum aliases below Nyquist), and
+        # the MTF must reach the grid's highest frequency, √2 × Nyquist, or fall to nothing first.
+        optics, pixel_um = self.optics, self.sensor.pixel_um
+        if optics._table_path is None:  # a spec from no file: its table is checked when first read
+            return self
+        if optics.psf_table is not None:
+            spacing = _lens.read_psf_table(optics._table_path).spacing_um
+            if spacing > pixel_um:
+                raise ValueError(f"optics.psf_table {optics.psf_table!r} is sampled every {spacing:g} um, coarser than "
+                                 f"the {pixel_um:g} um pixels: sample the PSF at least as finely as the pixel pitch")
+        if optics.mtf_table is not None:
+            table = _lens.read_mtf_table(optics._table_path)
+            reach = math.sqrt(2.0) * self.nyquist_cy_per_mm
+            for wl, freq, mtf in zip(table.wavelengths_nm, table.frequency_cy_per_mm, table.mtf):
+                if freq[-1] < reach and mtf[-1] > 0.01:
+                    raise ValueError(f"optics.mtf_table {optics.mtf_table!r}: wavelength {wl:g} nm ends at "
+                                     f"{freq[-1]:g} cy/mm with mtf {mtf[-1]:g}; the {pixel_um:g} um pixel grid reaches "
+                                     f"{reach:.1f} cy/mm (sqrt(2) x Nyquist): extend the table, or end it where the "
+                                     "MTF has fallen to 0.01")
         return self
 
     @property

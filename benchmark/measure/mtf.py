@@ -29,10 +29,11 @@ import math
 import numpy as np
 import scipy.optimize
 
-from benchmark.camera import exposure, isp, optics, sensor
+from benchmark.camera import exposure, isp, sensor
 from benchmark.camera.calibration import illuminant_gains, illuminant_spectrum
+from benchmark.camera.lens import lens_otf
 from benchmark.camera.pipeline import camera_extent, electron_rate
-from benchmark.camera.spec import CameraSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec, OpticsSpec, SensorSpec
 from benchmark.measure.targets import slanted_edge_scene
 from metricscenes.spectral import WAVELENGTHS_NM
 
@@ -118,15 +119,21 @@ def mtf50_analytic_cy_per_mm(
     *,
     sensor_spec: SensorSpec | None = None,
     spectrum: np.ndarray | None = None,
+    optics: OpticsSpec | None = None,
 ) -> float:
-    """MTF50 (cycles/mm) of diffraction × square-pixel aperture (sinc, fill factor 1).
+    """MTF50 (cycles/mm) of the lens's OTF × square-pixel aperture (sinc, fill factor 1),
+    along the horizontal frequency axis (what a near-vertical edge measures).
 
-    With ``wavelength_nm`` the OTF is monochromatic. Without it (default) it is
-    polychromatic: the per-band OTFs weighted by :func:`luminance_weights_per_band`
+    The lens is ``optics`` (:func:`benchmark.camera.lens.lens_otf`: aberrations, measured
+    tables and veiling glare included), by default the diffraction-limited lens at
+    ``f_number``. With ``wavelength_nm`` the OTF is monochromatic. Without it (default) it
+    is polychromatic: the per-band OTFs weighted by :func:`luminance_weights_per_band`
     (IMX363 QE × IR-cut, D65 edge unless given) — exact for the noise-free linear
     luminance the e-SFR measures, because that luminance is a fixed linear combination
-    of the bands. Demosaicking is not modelled.
+    of the bands. Demosaicking is not modelled. The first crossing of 0.5 is returned.
     """
+    # the ideal lens at f_number, unvalidated: the oracle also serves limits such as f/0.001
+    lens = optics if optics is not None else OpticsSpec.model_construct(f_number=float(f_number))
     pixel_mm = pixel_um * 1e-3
     if wavelength_nm is not None:
         wl, w = np.array([float(wavelength_nm)]), np.array([1.0])
@@ -135,12 +142,24 @@ def mtf50_analytic_cy_per_mm(
         illum = illuminant_spectrum("D65") if spectrum is None else spectrum
         wl, w = WAVELENGTHS_NM, luminance_weights_per_band(spec, illum)
 
-    def mtf(f):
-        h = sum(wi * optics.diffraction_mtf(f, li, f_number) for wi, li in zip(w, wl))
-        return h * np.sinc(f * pixel_mm) - 0.5
+    def excess(f):
+        """|polychromatic OTF| × pixel sinc − 0.5 at horizontal frequencies ``f``."""
+        f = np.atleast_1d(np.asarray(f, float))
+        h = sum(wi * lens_otf(lens, li, f, np.zeros(1))[0] for wi, li in zip(w, wl))
+        return np.abs(h) * np.sinc(f * pixel_mm) - 0.5
 
-    hi = min(1.0 / (wl.min() * 1e-6 * f_number), 1.0 / pixel_mm)
-    return float(scipy.optimize.brentq(mtf, 1e-6, hi))
+    # A pupil passes nothing beyond its cutoff; the pixel sinc is zero at 1 / pixel.
+    hi = 1.0 / pixel_mm
+    if lens.psf_table is None and lens.mtf_table is None:
+        hi = min(1.0 / (wl.min() * 1e-6 * lens.f_number), hi)
+    grid = np.linspace(1e-6, hi, 257)
+    below = np.nonzero(excess(grid) < 0)[0]
+    if below.size == 0:
+        return float("nan")
+    k = below[0]
+    if k == 0:
+        return float(grid[0])
+    return float(scipy.optimize.brentq(lambda f: float(excess(f)[0]), grid[k - 1], grid[k]))
 
 
 ISETCAM_EDGE_ANGLE_DEG = math.degrees(math.atan(1.0 / 2.6))
@@ -314,7 +333,8 @@ def camera_mtf50(camera: CameraSpec, prefer: str = "measured") -> tuple[float | 
             if source == "measured":
                 value = measure_mtf50(camera)["mtf50_cy_per_mm"]
             elif source == "analytic":
-                value = mtf50_analytic_cy_per_mm(camera.pixel_um, camera.f_number, sensor_spec=camera.sensor)
+                value = mtf50_analytic_cy_per_mm(camera.pixel_um, camera.f_number, sensor_spec=camera.sensor,
+                                                 optics=camera.optics)
             else:
                 value = camera.mtf50_group_cy_per_mm
         except (ValueError, RuntimeError):  # a camera the edge bench cannot image falls through
