@@ -25,21 +25,30 @@ from benchmark.experiments.sweep import od50_cell, with_censoring
 REFERENCE_POLICY = "auto_peak (reference)"
 POLICIES = {"percentile:99": "quick-policy-percentile-99", "mean_level@0.18": "quick-policy-mean_level-0.18",
             "hdr:16": "quick-policy-hdr-16"}
-SWEEPS = {"": "quick", "-640": "quick-640", "-native": "quick-native", "-illuminance": "quick-lux"}
+SWEEPS = {"": "quick", "-640": "quick-640", "-native": "quick-native", "-illuminance": "quick-lux",
+          "-day-paper": "quick-day-paper"}
+NIGHTS = ("night", "night_regulation")  # the paper's night, then the unlit regulation road
+POLICY_CONDITIONS = ("dusk", "night")  # the acquisition policies: dusk and the paper's night
 
 
 def publish(results: Path, out: Path) -> None:
     """docs/data's CSVs from the sweep folders under ``results``."""
     out.mkdir(parents=True, exist_ok=True)
     for suffix, folder in SWEEPS.items():
+        if not (results / folder).is_dir():
+            print(f"no {results / folder}: {out}/sweep{suffix}.csv and od50{suffix}.csv left as they are")
+            continue
         for name in ("sweep", "od50"):
             (out / f"{name}{suffix}.csv").write_bytes((results / folder / f"{name}.csv").read_bytes())
+    if not all((results / folder / "sweep.csv").exists() for folder in POLICIES.values()):
+        print(f"no policy sweeps under {results}: {out}/sweep-policies.csv and od50-policies.csv left as they are")
+        return
     reference_cameras = set(pd.read_csv(results / next(iter(POLICIES.values())) / "sweep.csv")["camera"])
     for name in ("sweep", "od50"):
         parts = []
         reference = pd.read_csv(results / "quick" / f"{name}.csv")
         reference = reference[reference["camera"].isin(reference_cameras)
-                              & reference["condition"].isin(["dusk", "night"])]
+                              & reference["condition"].isin(POLICY_CONDITIONS)]
         parts.append(reference.assign(exposure=REFERENCE_POLICY))
         parts += [pd.read_csv(results / folder / f"{name}.csv").assign(exposure=policy)
                   for policy, folder in POLICIES.items()]
@@ -108,7 +117,7 @@ def policy_tables(data: Path) -> str:
     od50 = pd.read_csv(data / "od50-policies.csv")
     policies = list(dict.fromkeys(table["exposure"]))
     out = []
-    for condition in ("dusk", "night"):
+    for condition in POLICY_CONDITIONS:
         header = [p.replace("auto_peak", "`auto_peak`") if p == REFERENCE_POLICY else f"`{p}`" for p in policies]
         lines = [_row(["camera", *header]), _rule(len(policies) + 1)]
         for camera in dict.fromkeys(table.loc[table["exposure"] != REFERENCE_POLICY, "camera"]):
@@ -121,7 +130,7 @@ def policy_tables(data: Path) -> str:
                 cell = _od50_metres(with_censoring(o, part).iloc[0])
                 cells.append(f"{ap[25.0]:.2f} / {ap[50.0]:.2f} / {cell}")
             lines.append(_row(cells))
-        out.append(f"{condition.capitalize()}:\n\n" + "\n".join(lines))
+        out.append(f"{condition}:\n\n" + "\n".join(lines))
     return "\n\n".join(out)
 
 
@@ -144,11 +153,42 @@ def _load(data: Path, suffix: str) -> tuple[pd.DataFrame, pd.DataFrame]:
     return table, with_censoring(pd.read_csv(data / f"od50{suffix}.csv"), table)
 
 
+def day_paper_table(data: Path) -> str:
+    """OD50 by day against the paper's 10-200 lux day (``day_paper``): the difference in SDs."""
+    table, od50 = _load(data, "")
+    paper_table, paper = _load(data, "-day-paper")
+    day = od50[od50["condition"] == "day"].set_index("camera")
+    lines = [_row(["camera", "OD50 day (m)", "OD50 day_paper (m)", "difference / SD"]), _rule(4)]
+    for camera, row in paper.set_index("camera").iterrows():
+        ref = day.loc[camera]
+        both = np.hypot(ref["sd_m"], row["sd_m"])
+        diff = (row["od50_m"] - ref["od50_m"]) / both if both > 0 else np.nan
+        lines.append(_row([camera, _od50_metres(ref), _od50_metres(row),
+                           "—" if not np.isfinite(diff) else _minus(f"{diff:.1f}")]))
+    return "\n".join(lines)
+
+
+def night_factors_table(data: Path) -> str:
+    """benchmarks/night_factors.py's rows: one change at a time at the paper's night's lux."""
+    rows = pd.read_csv(data / "night-factors.csv")
+    ap_cols = [c for c in rows.columns if c.startswith("ap_")]
+    lines = [_row(["camera", "factor", "change", "image-plane lux", "exposure (ms)", "car e⁻", "frame e⁻",
+                   *(f"AP {c[3:]}" for c in ap_cols)]), _rule(7 + len(ap_cols))]
+    for _, r in rows.iterrows():
+        lines.append(_row([r["camera"], r["factor"], r["variant"], f"{r['image_plane_lux']:.2f}", f"{r['exposure_ms']:.1f}",
+                           f"{r['car_median_e']:.1f}", f"{r['frame_mean_e']:.1f}", *(f"{r[c]:.2f}" for c in ap_cols)]))
+    return "\n".join(lines)
+
+
 def markdown(data: Path) -> str:
     table, od50 = _load(data, "")
-    parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", "night")]
+    parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])]
     parts += [f"### input size (day)\n\n{input_size_table(data)}", f"### policies\n\n{policy_tables(data)}",
               f"### illuminance\n\n{illuminance_table(data)}"]
+    if (data / "od50-day-paper.csv").exists():
+        parts.append(f"### day_paper\n\n{day_paper_table(data)}")
+    if (data / "night-factors.csv").exists():
+        parts.append(f"### night factors\n\n{night_factors_table(data)}")
     return "\n\n".join(parts)
 
 

@@ -29,7 +29,7 @@ from metricscenes.files import write_atomic
 
 REPRODUCE = """\
 metricscenes generate --manifest manifests/quick.yaml --out collections/quick
-benchmark sweep --collection collections/quick --conditions day,dusk,night --model yolov5n-dynamic --out sweeps/quick
+benchmark sweep --collection collections/quick --conditions day,dusk,night,night_regulation --model yolov5n-dynamic --out sweeps/quick
 benchmark submit sweeps/quick --name 'ref-{camera}-yolov5n-quick' --submitter 'metricscenes reference'
 benchmark leaderboard"""
 
