@@ -1,8 +1,16 @@
-"""The camera wing: specifications and the registry of the paper's 13 cameras (here),
-the stages (optics, distortion, sensor, exposure, hdr, isp, demosaic, calibration) and
-the pipeline that chains them (:mod:`benchmark.camera.pipeline`)."""
+"""The camera wing: specifications and the registry of the paper's 13 cameras and the
+extra (automotive) ones (here), the stages (lens, optics, distortion, sensor, exposure,
+acquisition with dual_gain, isp, demosaic, calibration) and the pipeline that chains them
+(:mod:`benchmark.camera.pipeline`)."""
 
-from benchmark.camera.registry import DATA_DIR, camera_from_dict, camera_names, list_cameras, load_camera
+from benchmark.camera.registry import (
+    DATA_DIR,
+    camera_from_dict,
+    camera_names,
+    extra_camera_names,
+    list_cameras,
+    load_camera,
+)
 from benchmark.camera.spec import CameraSpec, ExposureSpec, ISPSpec, OpticsSpec, SensorSpec
 
 __all__ = [
@@ -14,6 +22,7 @@ __all__ = [
     "SensorSpec",
     "camera_from_dict",
     "camera_names",
+    "extra_camera_names",
     "list_cameras",
     "load_camera",
 ]

@@ -36,9 +36,9 @@ class Calibration:
     """A sensor's colour calibration (float64 arrays, read-only by convention).
 
     Attributes:
-        color_matrix: (3, 3) white-balanced camera RGB → linear sRGB (rows sum to 1).
-        iset_mcc_matrix: (3, 3) camera RGB (not white-balanced) → CIE XYZ.
-        illuminant_gains: (3,) white-balance gains of the ISP's known illuminant (G gain 1).
+        color_matrix: (3, channels) white-balanced camera channels → linear sRGB (rows sum to 1).
+        iset_mcc_matrix: (3, channels) camera channels (not white-balanced) → CIE XYZ.
+        illuminant_gains: (channels,) white-balance gains of the ISP's known illuminant (G or C gain 1).
     """
 
     color_matrix: np.ndarray
@@ -63,7 +63,7 @@ def illuminant_spectrum(name: str, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) 
 
 
 def illuminant_gains(sensor: SensorSpec, illuminant: str = "D65") -> np.ndarray:
-    """Gains (3,) that make a perfect white under ``illuminant`` neutral (G gain 1)."""
+    """Gains (channels,) that make a perfect white under ``illuminant`` neutral (G or C gain 1)."""
     response = channel_responsivity(sensor) @ illuminant_spectrum(illuminant)
     return response[1] / response
 
@@ -86,37 +86,47 @@ def checker_targets_linear_srgb(wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> 
 
 
 def checker_camera_rgb(sensor: SensorSpec, wavelengths_nm: np.ndarray = WAVELENGTHS_NM) -> np.ndarray:
-    """White-balanced camera RGB (24, 3) of the ColorChecker under D65 (white = 1)."""
+    """White-balanced camera channels (24, channels) of the ColorChecker under D65 (white = 1)."""
     _, refl = checker_reflectances(wavelengths_nm)
     resp = channel_responsivity(sensor, wavelengths_nm)
     d65 = illuminant_spectrum("D65", wavelengths_nm)
     return (refl * d65) @ resp.T / (d65 @ resp.T)
 
 
-def _qe_sensor(qe_path: str) -> SensorSpec:
-    """A sensor that reads the QE file ``qe_path`` (the matrices depend on the spectral data only)."""
-    sensor = SensorSpec(pixel_um=1.0)
+def _qe_sensor(qe_path: str, cfa: str = "RGGB") -> SensorSpec:
+    """A sensor that reads the QE file ``qe_path`` behind the tile ``cfa`` (the matrices
+    depend on the spectral data only)."""
+    sensor = SensorSpec(pixel_um=1.0, cfa=cfa)
     sensor._qe_path = qe_path
     return sensor
 
 
 @functools.lru_cache(maxsize=32)
-def _color_matrix_cached(qe_path: str) -> np.ndarray:
-    sensor = _qe_sensor(qe_path)
+def _color_matrix_cached(qe_path: str, cfa: str = "RGGB") -> np.ndarray:
+    sensor = _qe_sensor(qe_path, cfa)
     cam = checker_camera_rgb(sensor)
     target = checker_targets_linear_srgb()
-    # Row sums fixed to 1: m3 = 1 − m1 − m2, so t − c3 = (c1 − c3) m1 + (c2 − c3) m2.
-    a = cam[:, :2] - cam[:, 2:3]
-    m = np.empty((3, 3))
+    # Row sums fixed to 1: m_n = 1 − m_1 − … − m_(n−1), so t − c_n = Σ_k (c_k − c_n) m_k.
+    last = cam.shape[1] - 1
+    a = cam[:, :last] - cam[:, last:]
+    m = np.empty((3, last + 1))
     for r in range(3):
-        sol, *_ = np.linalg.lstsq(a, target[:, r] - cam[:, 2], rcond=None)
-        m[r] = [sol[0], sol[1], 1.0 - sol.sum()]
+        sol, *_ = np.linalg.lstsq(a, target[:, r] - cam[:, last], rcond=None)
+        m[r] = [*sol, 1.0 - sol.sum()]
     return m
 
 
 def color_matrix(sensor: SensorSpec) -> np.ndarray:
-    """3×3 matrix from white-balanced camera RGB to linear sRGB (rows sum to 1)."""
-    return _color_matrix_cached(str(sensor.qe_path.resolve())).copy()
+    """Matrix (3, channels) from white-balanced camera channels to linear sRGB, rows summing
+    to 1 (a white-balanced neutral stays neutral): 3×3 for RGGB and RCCB, 3×2 for RCCC.
+
+    For RCCB the fit is the colour reconstruction: green is no channel of the sensor, and the
+    least-squares matrix forms it from C, R and B (its G row weighs C against R and B: about
+    C − R − B in the sensor's units) as the ColorChecker under D65 asks. For RCCC (red and
+    clear only) it is the best monochrome-plus-red rendering the fit allows: each output
+    channel a mix of R and C, so reds come out red and everything else in greys of the clear
+    channel (docs/camera.md, "Clear-pixel colour filters")."""
+    return _color_matrix_cached(str(sensor.qe_path.resolve()), sensor.cfa).copy()
 
 
 def checker_delta_e2000(sensor: SensorSpec) -> np.ndarray:
@@ -130,8 +140,8 @@ def checker_delta_e2000(sensor: SensorSpec) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=32)
-def _iset_mcc_matrix_cached(qe_path: str) -> np.ndarray:
-    sensor = _qe_sensor(qe_path)
+def _iset_mcc_matrix_cached(qe_path: str, cfa: str = "RGGB") -> np.ndarray:
+    sensor = _qe_sensor(qe_path, cfa)
     _, refl = checker_reflectances()
     resp = channel_responsivity(sensor)
     d65 = illuminant_spectrum("D65")
@@ -151,4 +161,4 @@ def iset_mcc_matrix(sensor: SensorSpec) -> np.ndarray:
     RGB counts photo-electrons, so it pairs with ordinary XYZ as ISETCam's quanta
     responses pair with ``xyzQuanta``. Rows need not sum to anything: ISETCam fixes the
     scale at the end (:func:`iset_render`)."""
-    return _iset_mcc_matrix_cached(str(sensor.qe_path.resolve())).copy()
+    return _iset_mcc_matrix_cached(str(sensor.qe_path.resolve()), sensor.cfa).copy()

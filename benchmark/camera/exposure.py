@@ -6,9 +6,9 @@ central region, t ≤ 16 ms (60 frames/s). Voltages here are signal volts at the
 (conversion gain × analog gain), without the black-level offset.
 
 Besides the reference (``auto_peak``) a run may choose ``mean_level``, ``percentile``,
-``hdr`` (two exposures, :mod:`benchmark.camera.hdr`) or ``fixed``; :func:`parse_exposure` reads
-the compact syntax of ``benchmark run/sweep --exposure`` (docs/camera.md,
-"Acquisition policies").
+``hdr`` (two exposures, :func:`benchmark.camera.acquisition.acquire_two_frames`) or
+``fixed``; :func:`parse_exposure` reads the compact syntax of ``benchmark run/sweep
+--exposure`` (docs/camera.md, "Acquisition policies").
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ def central_region(shape: tuple[int, int], fraction: float) -> tuple[slice, slic
     return slice(r0, r0 + h), slice(c0, c0 + w)
 
 
-def exposure_time_s(electron_rate: np.ndarray, sensor: SensorSpec, policy: ExposureSpec) -> float:
+def exposure_time_s(electron_rate: np.ndarray, sensor: SensorSpec, policy: ExposureSpec, *,
+                    range_ratio: float = 1.0) -> float:
     """Integration time, s, for a noise-free electron-rate mosaic (rows, cols), e⁻/s.
 
     ``auto_peak``: peak signal voltage in the central region at ``level`` × swing, the
@@ -45,6 +46,11 @@ def exposure_time_s(electron_rate: np.ndarray, sensor: SensorSpec, policy: Expos
     ``mean_level``: mean signal voltage there at ``level`` × swing; all capped at
     ``max_exposure_s`` (a black region gets the cap). ``fixed``: ``exposure_s``.
     ``hdr``: the long exposure of :func:`hdr_exposures_s`.
+
+    ``range_ratio``: a sensor whose merged signal holds this many times its (first) raw's
+    range, an HDR pixel (:func:`benchmark.camera.dual_gain.merged_range_ratio`): every policy
+    but ``fixed`` places its statistic at ``level`` of that range, i.e. exposes
+    ``range_ratio`` × longer, up to the cap.
     """
     if policy.mode == "fixed":
         return float(policy.exposure_s)
@@ -60,7 +66,10 @@ def exposure_time_s(electron_rate: np.ndarray, sensor: SensorSpec, policy: Expos
     volts_per_s = rate * signal_volts_per_electron(sensor)
     if not np.isfinite(volts_per_s) or volts_per_s <= 0:
         return float(policy.max_exposure_s)
-    return float(min(policy.level * sensor.voltage_swing_v / volts_per_s, policy.max_exposure_s))
+    exposure_s = policy.level * sensor.voltage_swing_v / volts_per_s
+    if range_ratio != 1.0:
+        exposure_s *= range_ratio
+    return float(min(exposure_s, policy.max_exposure_s))
 
 
 class HDRExposures(NamedTuple):

@@ -1,8 +1,10 @@
 """What a camera spec implies: field of view, IFOV, Nyquist and MTF50 (cycles/mm on the
-sensor and cycles/mrad in object space), saturation, dynamic range, SNR at a stated
-reference, and warnings where the spec hides something (a well the gain makes
-unreachable, a value outside what most sensors have). ``benchmark cameras show`` prints
-them (docs/camera.md, "Field of view and geometry", "What a spec implies").
+sensor and cycles/mrad in object space, through the whole chain), saturation, dynamic
+range, SNR at a stated reference, the figures of an EMVA 1288 report measured on the
+model's photon transfer (dynamic range, SNR10 and SNR1 illuminance, HDR transitions), and
+warnings where the spec hides something (a well the gain makes unreachable, a value
+outside what most sensors have). ``benchmark cameras show`` prints them (docs/camera.md,
+"Field of view and geometry", "What a spec implies", "Datasheet figures").
 
 Every figure is computed from the spec with the pipeline's own formulas: saturation by
 :func:`benchmark.camera.sensor.saturation_electrons`, the reference signal by
@@ -29,7 +31,7 @@ def reference_exposure_s(camera: CameraSpec) -> float:
 
 
 def reference_signal_e_per_s(camera: CameraSpec) -> float:
-    """Signal rate of a green pixel on the axis, e⁻/s, viewing a 18 % grey Lambertian
+    """Signal rate of a green pixel (clear, for RCCB and RCCC) on the axis, e⁻/s, viewing a 18 % grey Lambertian
     surface under 100 lux of D65 (luminance 0.18 × 100 / π cd/m²): the pipeline's optics
     and sensor response on a uniform scene, diffraction off (it does not change a
     uniform field)."""
@@ -48,15 +50,21 @@ def reference_signal_e_per_s(camera: CameraSpec) -> float:
 
 
 def camera_figures(camera: CameraSpec) -> dict:
-    """What the spec implies, as a JSON-ready dict (units in the keys)."""
+    """What the spec implies, as a JSON-ready dict (units in the keys). ``datasheet``: the
+    figures of an EMVA 1288 report measured on the model's photon transfer
+    (:func:`benchmark.measure.photon_transfer.datasheet_figures`); the rest from the spec's
+    formulas. An HDR pixel (``sensor.dcg``): saturation is the top of the merged range, the
+    noise floor the HCG readout's, and ``hdr_readouts`` lists the readouts."""
+    from benchmark.camera import dual_gain
     from benchmark.camera.sensor import saturation_electrons, signal_volts_per_electron
     from benchmark.measure.mtf import camera_mtf50
+    from benchmark.measure.photon_transfer import datasheet_figures
 
     s = camera.sensor
     mtf50, mtf50_source = camera_mtf50(camera)
     volts_per_e = signal_volts_per_electron(s)
     adc_e = (s.white_level_dn - s.black_level_dn) * s.lsb_v / volts_per_e
-    saturation = saturation_electrons(s)
+    saturation = saturation_electrons(s) if s.dcg is None else dual_gain.merged_saturation_e(s)
     e_per_dn = s.lsb_v / volts_per_e
     # Noise floor: read noise, DSNU (volts before the analog gain) and the ADC's LSB/√12.
     dsnu_e = s.dsnu_v / (s.conversion_gain_uv_per_e * 1e-6)
@@ -65,8 +73,15 @@ def camera_figures(camera: CameraSpec) -> dict:
     rate = reference_signal_e_per_s(camera)
     signal = min(rate * t, saturation)
     dark = s.dark_current_e_per_s * t
-    noise = math.sqrt(signal + dark + (s.prnu_fraction * signal) ** 2 + floor**2)
+    if s.dcg is None:
+        noise = math.sqrt(signal + dark + (s.prnu_fraction * signal) ** 2 + floor**2)
+    else:  # the readout the merge takes at this signal: its shot and read noise
+        noise = math.sqrt(dual_gain.temporal_variance_e2(s, signal) + dark + (s.prnu_fraction * signal) ** 2)
     snr = signal / noise if noise > 0 else math.inf
+    limited_by = "adc" if adc_e < s.well_capacity_e else "well"
+    if s.dcg is not None:
+        last = dual_gain.readouts(s)[-1]
+        limited_by = f"{last.name} {'well' if last.saturation_e >= last.well_capacity_e else 'adc'}"
     return {
         "focal_length_mm": camera.optics.focal_length_mm,
         "size_px": [camera.width_px, camera.height_px],
@@ -80,7 +95,7 @@ def camera_figures(camera: CameraSpec) -> dict:
                   "cy_per_mrad": None if mtf50 is None else round(camera.cy_per_mrad(mtf50), 4),
                   "source": mtf50_source},
         "saturation_e": round(saturation, 1),
-        "saturation_limited_by": "adc" if adc_e < s.well_capacity_e else "well",
+        "saturation_limited_by": limited_by,
         "well_capacity_e": s.well_capacity_e,
         "adc_saturation_e": round(adc_e, 1),
         "e_per_dn": round(e_per_dn, 4),
@@ -88,7 +103,7 @@ def camera_figures(camera: CameraSpec) -> dict:
         "dynamic_range_db": round(20 * math.log10(saturation / floor), 2) if floor > 0 else None,
         "snr_reference": {
             "scene": f"{REFERENCE_REFLECTANCE:.0%} grey Lambertian, {REFERENCE_ILLUMINANCE_LUX:g} lux "
-                     f"{REFERENCE_ILLUMINANT}, green pixel on the axis, no ISP",
+                     f"{REFERENCE_ILLUMINANT}, {'clear' if 'C' in s.cfa else 'green'} pixel on the axis, no ISP",
             "exposure_s": t,
             "signal_e": round(signal, 2),
             "clipped": rate * t > saturation,
@@ -96,6 +111,11 @@ def camera_figures(camera: CameraSpec) -> dict:
             "snr_db": round(20 * math.log10(snr), 2) if 0 < snr < math.inf else None,
         },
         "capture_memory_gib": round(s.capture_memory_bytes / 2**30, 3),
+        **({} if s.dcg is None else {"hdr_readouts": [
+            {"name": r.name, "conversion_gain_uv_per_e": r.conversion_gain_uv_per_e, "read_noise_e": r.read_noise_e,
+             "saturation_e": round(r.saturation_e / r.sensitivity, 1), "takes_over_e": r.takes_over_e}
+            for r in dual_gain.readouts(s)]}),
+        "datasheet": datasheet_figures(camera),
     }
 
 
@@ -108,7 +128,9 @@ def camera_warnings(camera: CameraSpec, figures: dict | None = None) -> list[str
     s = camera.sensor
     out = []
     adc_e, well = f["adc_saturation_e"], s.well_capacity_e
-    if adc_e < well:
+    if s.dcg is not None:  # the HCG readout saturates by design: the merge hands its pixels on
+        out.extend(companding_warnings(s))
+    elif adc_e < well:
         usable_gain = s.analog_gain * adc_e / well
         out.append(f"the ADC clips at {adc_e:.0f} e- (voltage swing / (conversion gain x analog gain "
                    f"{s.analog_gain:.3g}), less the black level) before the {well:.0f} e- well fills: "
@@ -133,6 +155,27 @@ def camera_warnings(camera: CameraSpec, figures: dict | None = None) -> list[str
     return out + plausibility_warnings(camera)
 
 
+def companding_warnings(sensor) -> list[str]:
+    """One line per companding segment the merged range reaches whose step (merged codes per
+    output code) exceeds the merged signal's temporal noise where it starts: there the
+    companding, not the light, sets the noise (docs/camera.md, "Acquisition")."""
+    from benchmark.camera import dual_gain
+
+    k = dual_gain.dn_per_electron(sensor, dual_gain.readouts(sensor)[0])
+    top = sensor.black_level_dn + dual_gain.merged_saturation_e(sensor) * k
+    knees = sensor.dcg.companding_knees
+    out = []
+    for (x0, y0), (x1, y1) in zip(knees[:-1], knees[1:]):
+        step = (x1 - x0) / (y1 - y0)
+        if x0 > top or step <= 1.0:
+            continue
+        noise = math.sqrt(dual_gain.temporal_variance_e2(sensor, max(x0 - sensor.black_level_dn, 0) / k)) * k
+        if step > noise:
+            out.append(f"sensor.dcg.companding_knees: the segment from merged code {x0} steps {step:.3g} codes, more "
+                       f"than the temporal noise there ({noise:.3g} codes): the companding adds visible noise")
+    return out
+
+
 def figure_rows(figures: dict) -> list[tuple[str, str]]:
     """(label, value) rows of :func:`camera_figures` for a table."""
     snr = figures["snr_reference"]
@@ -150,17 +193,44 @@ def figure_rows(figures: dict) -> list[tuple[str, str]]:
                     f"{figures['nyquist_cy_per_mrad']:.3f} cy/mrad in object space"),
         ("MTF50", _mtf50_text(figures["mtf50"], figures["focal_length_mm"])),
         ("saturation", f"{figures['saturation_e']:.0f} e- ({figures['saturation_limited_by']}; well "
-                       f"{figures['well_capacity_e']:.0f} e-, ADC {figures['adc_saturation_e']:.0f} e-)"),
+                       f"{figures['well_capacity_e']:.0f} e-, ADC {figures['adc_saturation_e']:.0f} e-)"
+         + ("" if "hdr_readouts" not in figures else "; merged range of the readouts " + ", ".join(
+             f"{r['name']} {r['conversion_gain_uv_per_e']:g} uV/e- to {r['saturation_e']:.0f} e-"
+             for r in figures["hdr_readouts"]))),
         ("dynamic range", (f"{dr:.1f} dB" if dr is not None else "inf") +
          f" (saturation / noise floor {figures['noise_floor_e']:.2f} e-: read, DSNU, LSB/sqrt(12))"),
         ("SNR reference", snr_text),
         ("memory per capture", f"about {figures['capture_memory_gib']:.2f} GiB"),
+        *_datasheet_rows(figures["datasheet"]),
     ]
+
+
+def _datasheet_rows(sheet: dict) -> list[tuple[str, str]]:
+    """Rows of the photon-transfer figures (:func:`benchmark.measure.photon_transfer.datasheet_figures`)."""
+    def lux(value):
+        return "-" if value is None else f"{value:.3g} lux"
+
+    rows = [
+        ("photon transfer", sheet["method"]),
+        ("measured DR", (f"{sheet['dynamic_range_db']:.1f} dB" if sheet["dynamic_range_db"] else "-") +
+         f" (photon transfer: saturation {sheet['saturation_e']:.0f} e- / dark noise {sheet['dark_noise_e']:.3g} e-)"),
+        ("SNR10", f"{lux(sheet['snr10_lux'])} at the sensor ({sheet['snr10_e'] or 0:.1f} e-; "
+                  f"{sheet['electrons_per_lux_s']:.0f} e- per lux.s)"),
+        ("SNR1", f"{lux(sheet['snr1_lux'])} at the sensor ({sheet['snr1_e'] or 0:.2f} e-)"),
+        ("SNR max", f"{sheet['snr_max_db']:.1f} dB"),
+    ]
+    for t in sheet["transitions"]:
+        after = "-" if t["snr_db_after"] is None else f"{t['snr_db_after']:.1f} dB"
+        rows.append((f"HDR {t['from']} -> {t['to']}",
+                     f"transition at {t['electrons'] or 0:.0f} e- of the large photodiode, {lux(t['lux'])} at "
+                     f"the sensor; SNR {after} just after"))
+    return rows
 
 
 def _mtf50_text(mtf50: dict, focal_length_mm: float) -> str:
     """"229.3 cy/mm on the sensor, 1.004 cy/mrad in object space (× f 4.38 mm; measured)"."""
     if mtf50["cy_per_mm"] is None:
         return "- (no source gave one)"
+    through = " through the whole chain: lens, sensor, acquisition, demosaic" if mtf50["source"] == "measured" else ""
     return (f"{mtf50['cy_per_mm']:.1f} cy/mm on the sensor, {mtf50['cy_per_mrad']:.3f} cy/mrad in object space "
-            f"(x f {focal_length_mm:g} mm / 1000; {mtf50['source']})")
+            f"(x f {focal_length_mm:g} mm / 1000; {mtf50['source']}{through})")

@@ -1,9 +1,10 @@
-"""Image signal processing: raw Bayer DN to an sRGB image.
+"""Image signal processing: an acquisition's linear mosaic (DN) to an sRGB image.
 
 Order (as dcraw and most camera ISPs): black-level subtraction and normalisation →
 white-balance gains on the mosaic → demosaic (Malvar, He & Cutler 2004, ICASSP, by
 default, in float32 by :mod:`benchmark.camera.demosaic`; bilinear option, colour-demosaicing)
-→ 3×3 colour matrix to linear sRGB → sRGB transfer curve (IEC 61966-2-1) → 8 bit.
+→ colour matrix to linear sRGB (3×3 for RGGB and RCCB, 3×2 for RCCC) → for an HDR
+capture, the tone curve → sRGB transfer curve (IEC 61966-2-1) → 8 bit (:func:`render`).
 
 The ISP knows its sensor through a :class:`benchmark.camera.calibration.Calibration` (colour
 matrices, white-balance gains), fitted once from the sensor's spectra and handed in:
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import functools
 from importlib import resources
+from typing import TYPE_CHECKING
 
 import colour
 import colour_demosaicing
@@ -22,7 +24,10 @@ import numpy as np
 from benchmark.camera.calibration import Calibration
 from benchmark.camera.spec import ISPSpec, SensorSpec
 from benchmark.camera.demosaic import malvar2004
-from benchmark.camera.sensor import bayer_sites
+from benchmark.camera.sensor import bayer_sites, cfa_channels
+
+if TYPE_CHECKING:
+    from benchmark.camera.acquisition import RawCapture
 
 
 def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
@@ -32,15 +37,16 @@ def raw_to_linear(raw_dn: np.ndarray, sensor: SensorSpec) -> np.ndarray:
 
 
 def grey_world_gains(mosaic: np.ndarray, cfa: str = "RGGB") -> np.ndarray:
-    """Gains (3,) making the R, G, B means of the mosaic equal (G gain 1)."""
-    sums, counts = np.zeros(3), np.zeros(3)
+    """Gains (channels,) making the channel means of the mosaic equal (G, or C, gain 1)."""
+    n = len(cfa_channels(cfa))
+    sums, counts = np.zeros(n), np.zeros(n)
     for dy, dx, channel in bayer_sites(cfa):
         site = mosaic[dy::2, dx::2]
         sums[channel] += site.sum(dtype=np.float64)
         counts[channel] += site.size
     means = sums / np.maximum(counts, 1)
     if np.any(means <= 0):
-        return np.ones(3)
+        return np.ones(n)
     return means[1] / means
 
 
@@ -51,16 +57,31 @@ def apply_gains(mosaic: np.ndarray, gains: np.ndarray, cfa: str = "RGGB") -> np.
     return out
 
 
+CLEAR_CFAS = ("RCCB", "RCCC")
+"""Tiles with clear (unfiltered) pixels in green's place."""
+
+
 def demosaic(mosaic: np.ndarray, method: str = "malvar2004", cfa: str = "RGGB") -> np.ndarray:
-    """(rows, cols) mosaic → (rows, cols, 3) float32 RGB (``malvar2004``: the float32
-    implementation in :mod:`benchmark.camera.demosaic`; ``bilinear``: colour-demosaicing)."""
+    """(rows, cols) mosaic → (rows, cols, channels) float32 camera channels (:func:`cfa_channels`;
+    ``malvar2004``: the float32 implementation in :mod:`benchmark.camera.demosaic`;
+    ``bilinear``: colour-demosaicing).
+
+    Clear-pixel tiles are demosaicked as the Bayer tile they replace, clear in green's place:
+    RCCB's R, C, B sit where RGGB's R, G, B do, so the Bayer kernels give R, C, B (the clear
+    channel, like green, is sampled twice per tile and correlates with the others). RCCC
+    gives R and C: the same kernels on the tile read as RGGB interpolate R everywhere and C
+    at the R pixels; the pixels in blue's place are clear and keep their own value."""
+    bayer = "RGGB" if cfa in CLEAR_CFAS else cfa
     if method == "malvar2004":
-        return malvar2004(mosaic, cfa)
+        out = malvar2004(mosaic, bayer)
     elif method == "bilinear":
-        rgb = colour_demosaicing.demosaicing_CFA_Bayer_bilinear(mosaic, cfa)
+        out = np.asarray(colour_demosaicing.demosaicing_CFA_Bayer_bilinear(mosaic, bayer), dtype=np.float32)
     else:
         raise ValueError(f"isp.demosaic: unknown method {method!r} (allowed: malvar2004, bilinear)")
-    return np.asarray(rgb, dtype=np.float32)
+    if cfa == "RCCC":
+        out = np.ascontiguousarray(out[..., :2])
+        out[1::2, 1::2, 1] = np.asarray(mosaic, dtype=np.float32)[1::2, 1::2]
+    return out
 
 
 _BUCKET_SHIFT = 12  # float32 bit patterns >> 12: never two decision levels in one bucket (checked below)
@@ -106,8 +127,21 @@ def encode_srgb8(rgb_linear: np.ndarray) -> np.ndarray:
     return base[bucket] + (x >= following[bucket])
 
 
+def render(raw: "RawCapture", sensor: SensorSpec, isp: ISPSpec,
+           calibration: Calibration) -> tuple[np.ndarray, np.ndarray]:
+    """An acquisition's linear signal (:class:`benchmark.camera.acquisition.RawCapture`) → (linear
+    sRGB (rows, cols, 3) float32, 8-bit sRGB). An HDR capture is scaled so that 1 is its
+    reference exposure's white and tone-mapped (:func:`tone_curve_reinhard` with its merged
+    white) before the encoding; its linear sRGB is the scaled image before the tone curve."""
+    rgb_linear = process(raw.linear_dn, sensor, isp, calibration)
+    if raw.reference_scale is None:
+        return rgb_linear, encode_srgb8(rgb_linear)
+    rgb_linear = rgb_linear * np.float32(raw.reference_scale)
+    return rgb_linear, encode_srgb8(tone_curve_reinhard(rgb_linear, white=raw.white))
+
+
 def process(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec, calibration: Calibration) -> np.ndarray:
-    """Raw Bayer DN (rows, cols) → linear sRGB (rows, cols, 3) float32 (not clipped)."""
+    """Raw mosaic DN (rows, cols) → linear sRGB (rows, cols, 3) float32 (not clipped)."""
     rgb = white_balanced_rgb(raw_dn, sensor, isp, calibration)
     if isp.color_transform == "iset_mcc":
         return iset_render(rgb, calibration.iset_mcc_matrix)
@@ -116,12 +150,13 @@ def process(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec, calibration: C
 
 
 def white_balanced_rgb(raw_dn: np.ndarray, sensor: SensorSpec, isp: ISPSpec, calibration: Calibration) -> np.ndarray:
-    """Raw DN → black-subtracted, white-balanced, demosaicked camera RGB (float32)."""
+    """Raw DN → black-subtracted, white-balanced, demosaicked camera channels (float32,
+    (rows, cols, channels): R, G, B, or R, C, B and R, C for clear-pixel tiles)."""
     lin = raw_to_linear(raw_dn, sensor)
     if isp.white_balance == "grey_world":
         gains = grey_world_gains(lin, sensor.cfa)
     elif isp.white_balance == "none":
-        gains = np.ones(3)
+        gains = np.ones(len(cfa_channels(sensor.cfa)))
     else:
         gains = calibration.illuminant_gains
     return demosaic(apply_gains(lin, gains, sensor.cfa), isp.demosaic, sensor.cfa)

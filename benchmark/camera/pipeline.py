@@ -3,10 +3,12 @@
 ``simulate(scene, camera, seed=...)`` is what ``benchmark run`` calls for every scene:
 
     radiance (resampled to the pixel grid) ──lens──▶ optical image ──sensor QE──▶
-    electron-rate per channel ──Bayer mosaic──▶ exposure policy ──sensor (noise)──▶ raw DN ──ISP──▶ sRGB 8-bit
+    electron rate per channel ──colour filter mosaic──▶ signal ──acquisition──▶ raw capture ──ISP──▶ sRGB 8-bit
 
-The ``hdr`` exposure policy captures a long and a short raw and merges them before the
-ISP (:mod:`benchmark.camera.hdr`), then tone-maps before the sRGB encoding.
+The acquisition (:mod:`benchmark.camera.acquisition`) sets the exposure and reads the raw
+frames: one exposure, the ``hdr`` policy's long and short raws merged before the ISP, or
+an HDR pixel (``sensor.dcg``) merged and companded on the sensor; the ISP tone-maps an
+HDR capture before the sRGB encoding.
 
 Geometry: the camera sees its own field, 2·atan(width_px · pixel / 2f) ×
 2·atan(height_px · pixel / 2f), a window of the scene's field centred on the optical
@@ -22,9 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from benchmark.camera import acquisition as _acquisition
 from benchmark.camera import distortion as _distortion
-from benchmark.camera import exposure as _exposure
-from benchmark.camera import hdr as _hdr
 from benchmark.camera import isp as _isp
 from benchmark.camera import optics as _optics
 from benchmark.camera import sensor as _sensor
@@ -40,7 +41,7 @@ class Capture:
 
     Attributes:
         rgb8: (height, width, 3) uint8 sRGB.
-        raw_dn: (height, width) uint16 Bayer RGGB mosaic, black level included.
+        raw_dn: (height, width) uint16 mosaic (the sensor's colour filter tile), black level included.
         exposure_s: integration time, s.
         camera_name: the camera's registry name.
         width_px, height_px: image size.
@@ -53,8 +54,14 @@ class Capture:
         exposure_short_s: ``hdr`` only: the short exposure, s (``exposure_s`` and
             ``raw_dn`` are then the long one's).
         raw_short_dn: ``hdr`` only: the short exposure's raw, uint16.
-        merged_dn: ``hdr`` only: the merged raw (float32 DN on the long exposure's scale,
-            black level included) that the ISP processed.
+        merged_dn: HDR only: the merged linear raw (float32 DN on the first frame's scale,
+            black level included) that the ISP processed (``hdr``: on the long exposure's;
+            ``sensor.dcg``: the HCG readout's, decompanded from the output).
+        raw: the acquisition (:class:`benchmark.camera.acquisition.RawCapture`) the fields
+            above come from: every frame, the merged and companded words.
+
+    With ``sensor.dcg``, ``raw_dn`` is the sensor's companded output (uint16, the
+    ``companded_bits`` codes) and ``exposure_s`` the one exposure.
     """
 
     rgb8: np.ndarray
@@ -70,6 +77,7 @@ class Capture:
     exposure_short_s: float | None = None
     raw_short_dn: np.ndarray | None = None
     merged_dn: np.ndarray | None = None
+    raw: _acquisition.RawCapture | None = None
 
 
 class FieldOfViewError(ValueError):
@@ -167,7 +175,11 @@ def optical_image(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple[i
 
 
 def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool = True) -> Capture:
-    """Simulate one capture of ``scene`` by ``camera``.
+    """Simulate one capture of ``scene`` by ``camera``: its optical image
+    (:func:`optical_image`) → the sensor's signal (electron rate per channel, on the colour
+    filter mosaic) → the acquisition (:func:`benchmark.camera.acquisition.acquire`: one
+    exposure, two-frame HDR or an HDR pixel) → the ISP (:func:`benchmark.camera.isp.render`).
+    Each stage takes the previous one's value and never reaches back.
 
     Args:
         scene: spectral radiance, W·sr⁻¹·m⁻²·nm⁻¹, over a field at least the camera's
@@ -176,56 +188,24 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
         seed: temporal-noise seed (``np.random.default_rng(seed)``): same seed, same raw.
         noise: False switches every noise source off (shot, read, dark, PRNU, DSNU).
     """
-    rate = _sensor.mosaic(electron_rate(scene, camera), camera.sensor.cfa)
-    if camera.exposure.mode == "hdr":
-        return _simulate_hdr(rate, camera, seed=seed, noise=noise)
-    exposure_s = _exposure.exposure_time_s(rate, camera.sensor, camera.exposure)
-    opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
-    raw = _sensor.capture_dn(rate, exposure_s, camera.sensor, np.random.default_rng(seed), opts)
-    rgb_linear = _isp.process(raw, camera.sensor, camera.isp, calibrate(camera.sensor, camera.isp))
+    oi = optical_image(scene, camera)
+    signal = _sensor.mosaic(_sensor.electron_rate(oi, camera.sensor), camera.sensor.cfa)
+    raw = _acquisition.acquire(signal, camera, seed=seed, noise=noise)
+    rgb_linear, rgb8 = _isp.render(raw, camera.sensor, camera.isp, calibrate(camera.sensor, camera.isp))
+    two_frames = raw.strategy == "two_frame_hdr"
     return Capture(
-        rgb8=_isp.encode_srgb8(rgb_linear),
-        raw_dn=raw,
-        exposure_s=exposure_s,
+        rgb8=rgb8,
+        raw_dn=raw.frames[0].raw_dn if raw.output_dn is None else raw.output_dn,
+        exposure_s=raw.exposure_s,
         camera_name=camera.name,
         width_px=camera.width_px,
         height_px=camera.height_px,
         seed=int(seed),
         camera_sha256=camera.sha256(),
-        electrons=np.multiply(rate, np.float32(exposure_s), dtype=np.float32),
+        electrons=raw.electrons,
         rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
-    )
-
-
-def _simulate_hdr(rate: np.ndarray, camera: CameraSpec, *, seed: int, noise: bool) -> Capture:
-    """The ``hdr`` policy on an electron-rate mosaic (e⁻/s): two raws, merge, ISP, tone curve.
-
-    The long frame draws its temporal noise from ``default_rng(seed)`` (the draws a
-    single capture would make), the short one from the first child of
-    ``SeedSequence(seed)`` (an independent stream): deterministic for a seed.
-    """
-    times = _exposure.hdr_exposures_s(rate, camera.sensor, camera.exposure)
-    opts = _sensor.NoiseOptions() if noise else _sensor.NoiseOptions.off()
-    short_rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
-    raw_long = _sensor.capture_dn(rate, times.long_s, camera.sensor, np.random.default_rng(seed), opts)
-    raw_short = _sensor.capture_dn(rate, times.short_s, camera.sensor, short_rng, opts)
-    merged = _hdr.merge_two_exposures_dn(raw_long, raw_short, times.long_s / times.short_s, camera.sensor)
-    # Rescale so that 1 is the reference exposure's white, the tone curve's unit.
-    calibration = calibrate(camera.sensor, camera.isp)
-    rgb_linear = _isp.process(merged, camera.sensor, camera.isp, calibration) * np.float32(times.reference_s / times.long_s)
-    toned = _isp.tone_curve_reinhard(rgb_linear, white=times.reference_s / times.short_s)
-    return Capture(
-        rgb8=_isp.encode_srgb8(toned),
-        raw_dn=raw_long,
-        exposure_s=times.long_s,
-        camera_name=camera.name,
-        width_px=camera.width_px,
-        height_px=camera.height_px,
-        seed=int(seed),
-        camera_sha256=camera.sha256(),
-        electrons=np.multiply(rate, np.float32(times.long_s), dtype=np.float32),
-        rgb_linear=rgb_linear if camera.isp.output == "linear" else None,
-        exposure_short_s=times.short_s,
-        raw_short_dn=raw_short,
-        merged_dn=merged,
+        exposure_short_s=raw.frame("short").exposure_s if two_frames else None,
+        raw_short_dn=raw.frame("short").raw_dn if two_frames else None,
+        merged_dn=None if raw.strategy == "single" else raw.linear_dn,
+        raw=raw,
     )

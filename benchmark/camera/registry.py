@@ -1,5 +1,6 @@
 """The camera registry: the paper's 13 cameras (``cam01`` ... ``cam13``) as packaged
-YAML files, plus user specs loaded from any YAML path.
+YAML files, the packaged extra cameras beside them (automotive HDR sensors, ``auto-*``:
+loaded by name, never part of the 13), plus user specs loaded from any YAML path.
 
 Errors are one-line :class:`ValueError` s naming the field and its allowed range, so a
 CLI can print them as they are. A spec file with a key twice is refused (YAML would keep
@@ -42,8 +43,15 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 
 
 def camera_names() -> list[str]:
-    """Names of the packaged cameras, in the paper's order."""
+    """Names of the paper's 13 cameras, in the paper's order: the registry that ``--cameras
+    all``, ``benchmark cameras list`` and the leaderboard mean."""
     return sorted(p.stem for p in DATA_DIR.glob("cam*.yaml"))
+
+
+def extra_camera_names() -> list[str]:
+    """Names of the packaged cameras beside the paper's 13 (the automotive HDR cameras,
+    ``auto-*``): loaded by name like a registry camera, never part of ``all``."""
+    return sorted(p.stem for p in DATA_DIR.glob("*.yaml") if not p.stem.startswith("cam"))
 
 
 def list_cameras() -> list[CameraSpec]:
@@ -62,12 +70,14 @@ def load_camera(name_or_path: str | int | Path) -> CameraSpec:
     path = Path(text)
     if text.isdigit():
         text = f"cam{int(text):02d}"
-    registry = text in camera_names()
+    registry = text in camera_names() or text in extra_camera_names()
     if registry:
         path = DATA_DIR / f"{text}.yaml"
     elif not (path.suffix.lower() in (".yaml", ".yml", ".json") or path.is_file()):
-        raise ValueError(f"unknown camera {name_or_path!r} (valid names: {', '.join(camera_names())})"
-                         f"{did_you_mean(text, camera_names(), guess=_registry_spelling(text))}")
+        known = camera_names() + extra_camera_names()
+        raise ValueError(f"unknown camera {name_or_path!r} (valid names: {', '.join(camera_names())}; "
+                         f"extra cameras: {', '.join(extra_camera_names())})"
+                         f"{did_you_mean(text, known, guess=_registry_spelling(text))}")
     if not path.is_file():
         raise ValueError(f"camera file not found: {path}")
     try:
@@ -93,7 +103,7 @@ def check_not_a_registry_name(camera: CameraSpec, source: str = "camera spec") -
     """One-line ValueError if a user spec calls itself by a registry camera's name (in any
     case) without being that camera's spec: its results would be read, compared and
     ranked as the registry camera's."""
-    taken = next((n for n in camera_names() if n.lower() == camera.name.lower()), None)
+    taken = next((n for n in camera_names() + extra_camera_names() if n.lower() == camera.name.lower()), None)
     if taken is None:
         return
     if camera.sha256() == load_camera(taken).sha256():  # the registry spec itself, copied

@@ -22,6 +22,10 @@ capture. Values no sensor has are refused with the unit mistake they most likely
 unusual but possible ones are warned about (:data:`PLAUSIBLE`, docs/camera.md, "Plausible
 values").
 
+A sensor may have clear pixels (``cfa: RCCB`` or ``RCCC``) and an HDR pixel read in one exposure
+(``dcg``: :mod:`benchmark.camera.spec_readout`); a lens table's content is recorded beside its
+name (``psf_table_sha256``, ``mtf_table_sha256``), so the camera's sha256 covers it.
+
 Specs that can grow: a field added after the registry and its leaderboard is declared with
 :func:`added_later`, and one rule (:class:`SpecModel`) leaves it out of the serialisation —
 hence out of :meth:`CameraSpec.sha256` — wherever it is at its default, so every earlier
@@ -30,28 +34,38 @@ spec keeps its bytes (docs/camera.md, "Adding a camera feature").
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
-from dataclasses import dataclass
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Literal
 
+import numpy as np
+
 from pydantic import (
-    BaseModel,
-    ConfigDict,
     Field,
     PrivateAttr,
     ValidationInfo,
     computed_field,
     field_serializer,
     field_validator,
-    model_serializer,
     model_validator,
 )
 
 from benchmark.camera import lens as _lens
 from benchmark.camera.distortion import check_monotonic, undistorted_bounds
+from benchmark.camera.spec_readout import DualGainSpec, SmallPhotodiodeSpec, check_dual_gain  # noqa: F401
+from benchmark.camera.spec_rules import (  # noqa: F401  (re-exported: the rules' old home)
+    ADDED_LATER,
+    PLAUSIBLE,
+    Plausible,
+    SpecModel,
+    _number,
+    _unit,
+    added_later,
+    check_plausible,
+)
 from benchmark.camera.tables import TABLE_WAVELENGTH_RANGE_NM, check_wavelengths_nm, read_numeric_csv
 from metricscenes.geometry import (
     REFERENCE_ACTIVE_HEIGHT_MM,
@@ -61,7 +75,6 @@ from metricscenes.geometry import (
 )
 from metricscenes.spectral import SENSOR_DATA_DIR, WAVELENGTHS_NM
 
-_STRICT = ConfigDict(extra="forbid", frozen=True)
 
 IMX363_ISO_SPEED = 270.0
 """ISO speed of ISETCam's ``sensorIMX363`` (its default, used by the paper)."""
@@ -101,74 +114,19 @@ def _check_relative_csv(value: str, columns: str, packaged: str = "") -> str:
     return value
 
 
+def file_sha256(path: str | Path) -> str:
+    """sha256 (hex) of a file's bytes; cached while the file's size and modification time stay."""
+    stat = Path(path).stat()
+    return _file_sha256(str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=32)
+def _file_sha256(path: str, size: int, mtime_ns: int) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
 def _check_qe_syntax(value: str) -> str:
     return _check_relative_csv(value, "wavelength_nm, qe_r, qe_g, qe_b", packaged="a packaged file (imx363_qe.csv) or ")
-
-
-@dataclass(frozen=True)
-class Plausible:
-    """Where one spec field's values lie on real sensors (docs/camera.md, "Plausible values").
-
-    A value outside ``refused`` is no sensor's: it is refused with the unit mistake it most
-    likely is (the first of ``mistakes``, ``(unit, factor to this field's unit)``, that
-    brings it inside). A value outside ``usual`` but inside ``refused`` is possible, and
-    ``benchmark cameras show`` warns about it."""
-
-    what: str
-    unit: str
-    refused: tuple[float, float]
-    usual: tuple[float, float]
-    mistakes_below: tuple[tuple[str, float], ...] = ()
-    mistakes_above: tuple[tuple[str, float], ...] = ()
-
-
-PLAUSIBLE: dict[str, Plausible] = {
-    "exposure.max_exposure_s": Plausible("an exposure cap", "s", (1e-7, 1.0), (1e-4, 0.1),
-                                         mistakes_above=(("ms", 1e-3), ("us", 1e-6))),
-    "exposure.exposure_s": Plausible("an exposure time", "s", (1e-7, 1.0), (1e-5, 0.1),
-                                     mistakes_above=(("ms", 1e-3), ("us", 1e-6))),
-    "sensor.conversion_gain_uv_per_e": Plausible("a conversion gain", "uV/e-", (1.0, 1000.0), (10.0, 300.0),
-                                                 mistakes_below=(("V/e-", 1e6), ("mV/e-", 1e3)),
-                                                 mistakes_above=(("nV/e-", 1e-3),)),
-    "sensor.well_capacity_e": Plausible("a full well", "e-", (300.0, 1e7), (2000.0, 1e6),
-                                        mistakes_below=(("ke-", 1e3),)),
-    "sensor.voltage_swing_v": Plausible("a pixel voltage swing", "V", (0.05, 5.0), (0.2, 3.3),
-                                        mistakes_above=(("mV", 1e-3),)),
-    "sensor.read_noise_e": Plausible("a read noise", "e-", (0.0, 1000.0), (0.0, 50.0)),
-    "sensor.dark_current_e_per_s": Plausible("a dark current", "e-/s", (0.0, 1e6), (0.0, 1000.0)),
-    "sensor.dsnu_v": Plausible("a DSNU", "V", (0.0, 0.1), (0.0, 0.01), mistakes_above=(("mV", 1e-3),)),
-    "sensor.prnu_fraction": Plausible("a PRNU", "(fraction)", (0.0, 0.1), (0.0, 0.03),
-                                      mistakes_above=(("percent", 1e-2),)),
-}
-"""Plausible ranges of the spec fields whose unit is easy to get wrong (sources in docs/camera.md)."""
-
-
-def _unit(unit: str) -> str:
-    return "" if unit.startswith("(") else f" {unit}"
-
-
-def _number(value: float) -> str:
-    """``10000000``, ``0.03``, ``1e-06``: as short as exact, without ``1e+07``."""
-    return f"{value:.0f}" if abs(value) >= 1e5 and float(value).is_integer() else f"{value:.6g}"
-
-
-def check_plausible(field: str, value):
-    """``value`` of ``field`` (``"sensor.well_capacity_e"``) if a sensor can have it; else a
-    one-line ValueError with the plausible range and the likely unit mistake. Not a number:
-    returned as it is, for pydantic's own check."""
-    rule = PLAUSIBLE[field]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        return value
-    lo, hi = rule.refused
-    if lo <= value <= hi:
-        return value
-    mistakes = rule.mistakes_below if value < lo else rule.mistakes_above
-    hint = next((f"; if it was meant in {unit}, write {_number(value * factor)}" for unit, factor in mistakes
-                 if lo <= value * factor <= hi), "")
-    side = "below" if value < lo else "above"
-    raise ValueError(f"{rule.what} of {_number(value)}{_unit(rule.unit)} is {side} the plausible range "
-                     f"{_number(lo)} to {_number(hi)}{_unit(rule.unit)} of real sensors{hint} "
-                     "(docs/camera.md, \"Plausible values\")")
 
 
 def plausibility_warnings(camera: "CameraSpec") -> list[str]:
@@ -190,16 +148,23 @@ QE_WAVELENGTH_RANGE_NM = TABLE_WAVELENGTH_RANGE_NM
 
 def check_qe_table(path: str | Path) -> tuple:
     """(wavelengths nm, QE (3, n), IR-cut (n) or None) of a QE CSV file if it is physically
-    possible: columns ``wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]``, two or more
-    rows, every value a finite number, wavelengths strictly increasing within
+    possible (:func:`read_qe_table`). Else a one-line ValueError naming the file, the row and
+    the column."""
+    wl, qe, ir_cut = read_qe_table(path)
+    return wl, np.stack([qe[c] for c in "rgb"]), ir_cut
+
+
+def read_qe_table(path: str | Path) -> tuple:
+    """(wavelengths nm, {"r", "g", "b"[, "c"]: QE (n)}, IR-cut (n) or None) of a QE CSV file if
+    it is physically possible: columns ``wavelength_nm, qe_r, qe_g, qe_b[, qe_c][,
+    ir_cut_transmittance]`` (``qe_c``: a measured clear-pixel curve), two or more rows, every
+    value a finite number, wavelengths strictly increasing within
     :data:`QE_WAVELENGTH_RANGE_NM`, QE and transmittance between 0 and 1 (a fraction of the
     photons). Else a one-line ValueError naming the file, the row and the column."""
-    import numpy as np
-
     name = Path(path).name
     columns = ("wavelength_nm", "qe_r", "qe_g", "qe_b")
-    table = read_numeric_csv(path, "QE table", columns, optional=("ir_cut_transmittance",),
-                             expected="wavelength_nm, qe_r, qe_g, qe_b[, ir_cut_transmittance]")
+    table = read_numeric_csv(path, "QE table", columns, optional=("qe_c", "ir_cut_transmittance"),
+                             expected="wavelength_nm, qe_r, qe_g, qe_b[, qe_c][, ir_cut_transmittance]")
     rows = table["wavelength_nm"].size
     if rows < 2:
         raise ValueError(f"QE table {name}: {rows} row(s); two or more wavelengths are needed")
@@ -218,7 +183,7 @@ def check_qe_table(path: str | Path) -> tuple:
             hint = "; if the table is in percent, divide it by 100" if 0 <= values.min() and values.max() <= 100 else ""
             raise ValueError(f"QE table {name}: row {i + 1} {column} is {values[i]:g}: a fraction of the photons, "
                              f"between 0 and 1{hint}")
-    qe = np.stack([table[f"qe_{c}"] for c in ("r", "g", "b")])
+    qe = {c: table[f"qe_{c}"] for c in "rgbc" if f"qe_{c}" in table}
     return wl, qe, table.get("ir_cut_transmittance")
 
 
@@ -228,36 +193,6 @@ def packaged_qe(name: str) -> Path | None:
         return None
     path = SENSOR_DATA_DIR / name
     return path if path.is_file() else None
-
-
-ADDED_LATER = "added_later"
-"""Marks (in ``json_schema_extra``) a field declared with :func:`added_later`."""
-
-
-def added_later(default, **constraints):
-    """A spec field added after the registry and its leaderboard (a ``Field`` with
-    ``default`` and its ``constraints``): :class:`SpecModel` writes it only where it is
-    not at its default, so every spec written before it keeps its canonical JSON, hence
-    its sha256 (docs/camera.md, "Adding a camera feature")."""
-    return Field(default, json_schema_extra={ADDED_LATER: True}, **constraints)
-
-
-class SpecModel(BaseModel):
-    """A part of a camera spec (frozen, no unknown keys), serialised by the one rule for
-    specs that grow: a field declared with :func:`added_later` is left out wherever it
-    is at its default."""
-
-    model_config = _STRICT
-
-    @model_serializer(mode="wrap")
-    def _omit_later_fields_at_default(self, handler):
-        data = handler(self)
-        if isinstance(data, dict):
-            for name, field in type(self).model_fields.items():
-                extra = field.json_schema_extra
-                if isinstance(extra, dict) and extra.get(ADDED_LATER) and getattr(self, name) == field.default:
-                    data.pop(name, None)
-        return data
 
 
 PSF_TABLE_COLUMNS = ", ".join(_lens.PSF_COLUMNS)
@@ -300,8 +235,39 @@ class OpticsSpec(SpecModel):
     """Scale angle θ₀ of the glare spread function (1 + (θ/θ₀)²)^(-3/2): 0.1°, the scale
     angle of the wide-angle terms of the CIE 146:2002 general disability glare equation."""
 
+    psf_table_sha256: str | None = added_later(None, pattern=r"^[0-9a-f]{64}$")
+    """sha256 of the ``psf_table`` file's content: filled when the spec is loaded from its file,
+    so the camera's sha256 covers the table and not only its name; kept from a spec that comes
+    from no file (results.json), and checked against the file wherever it is read."""
+    mtf_table_sha256: str | None = added_later(None, pattern=r"^[0-9a-f]{64}$")
+    """sha256 of the ``mtf_table`` file's content (as ``psf_table_sha256``)."""
+
     _table_path: str | None = PrivateAttr(None)
     """The resolved PSF or MTF table (a spec loaded from a file); None: unresolved."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _table_content_is_recorded(cls, data, info: ValidationInfo):
+        # Before the fields: the digest of a table beside the spec file becomes a field, so it is
+        # serialised (hence hashed) with the name. A path the field check refuses is left to it.
+        spec_dir = (info.context or {}).get(SPEC_DIR_CONTEXT)
+        if not isinstance(data, dict) or spec_dir is None:
+            return data
+        out = dict(data)
+        for name in ("psf_table", "mtf_table"):
+            value = data.get(name)
+            try:
+                path = Path(spec_dir) / _check_relative_csv(value, "") if isinstance(value, str) else None
+            except ValueError:
+                continue
+            if path is None or not path.is_file():
+                continue
+            digest, given = file_sha256(path), data.get(f"{name}_sha256")
+            if given is not None and given != digest:
+                raise ValueError(f"optics.{name}_sha256: the file {value!r} (sha256 {digest[:12]}...) is not the "
+                                 f"table this spec recorded ({str(given)[:12]}...)")
+            out[f"{name}_sha256"] = digest
+        return out
 
     @field_validator("zernike_waves", mode="before")
     @classmethod
@@ -368,6 +334,9 @@ class OpticsSpec(SpecModel):
                 raise ValueError(f"optics.zernike_waves: the wavefront's steepest slope, {slope:.3g} waves per pupil "
                                  f"radius at {WAVELENGTHS_NM.min():g} nm, is above the {limit:g} the pupil sampling "
                                  "holds: describe so blurred a lens by a PSF table")
+        for name in ("psf_table", "mtf_table"):
+            if getattr(self, f"{name}_sha256") is not None and getattr(self, name) is None:
+                raise ValueError(f"optics.{name}_sha256 is the digest of optics.{name}, which is not given")
         table = self.psf_table or self.mtf_table
         spec_dir = (info.context or {}).get(SPEC_DIR_CONTEXT) if info is not None else None
         if table is not None and spec_dir is not None:
@@ -387,6 +356,10 @@ class OpticsSpec(SpecModel):
         path = Path(self._table_path) if self._table_path is not None else Path(value)
         if not path.is_file():
             raise ValueError(f"optics.{name}: file {value!r} not found (a CSV beside the spec file)")
+        recorded = getattr(self, f"{name}_sha256")
+        if recorded is not None and file_sha256(path) != recorded:
+            raise ValueError(f"optics.{name}: file {value!r} has changed since this spec recorded it "
+                             f"(optics.{name}_sha256 {recorded[:12]}...)")
         return path
 
     @property
@@ -407,7 +380,10 @@ class SensorSpec(SpecModel):
     pixel_um: float = Field(..., ge=0.2, le=20.0)
     active_width_mm: float = Field(REFERENCE_ACTIVE_WIDTH_MM, gt=0.0, le=50.0)
     active_height_mm: float = Field(REFERENCE_ACTIVE_HEIGHT_MM, gt=0.0, le=50.0)
-    cfa: Literal["RGGB"] = "RGGB"
+    cfa: Literal["RGGB", "RCCB", "RCCC"] = "RGGB"
+    """The 2×2 colour filter tile, row by row: Bayer ``RGGB``, or ``RCCB`` / ``RCCC`` with clear
+    (unfiltered) pixels, whose QE is the table's ``qe_c`` column or, without one, the sum of
+    its R, G and B curves (docs/camera.md, "Clear-pixel colour filters")."""
     qe: str = Field("imx363_qe.csv", min_length=1, max_length=255)
     """Packaged CSV name (``metricscenes/data``), else a relative path from the spec
     file's folder (no absolute path, no ``..``); columns
@@ -428,6 +404,10 @@ class SensorSpec(SpecModel):
     fpn_seed: int = Field(0, ge=0)
     """Seed of the fixed-pattern noise maps (PRNU, DSNU): a property of the sensor
     unit, the same in every capture, independent of the capture seed."""
+    dcg: DualGainSpec | None = added_later(None)
+    """An HDR pixel read in one exposure (:class:`benchmark.camera.spec_readout.DualGainSpec`):
+    the charge read again at low gain, optionally a small photodiode, merged on the sensor and
+    companded. The fields above then describe the high-gain readout. None: one readout."""
 
     _qe_path: str | None = PrivateAttr(None)
     """Resolved user QE file (a spec loaded from a file); None: packaged or unresolved."""
@@ -455,6 +435,8 @@ class SensorSpec(SpecModel):
         if self.black_level_dn >= self.white_level_dn:
             raise ValueError(f"black_level_dn {self.black_level_dn} must be below the ADC white level "
                              f"{self.white_level_dn} (2^adc_bits - 1 for adc_bits {self.adc_bits})")
+        if self.dcg is not None:
+            check_dual_gain(self)
         if min(self.width_px, self.height_px) < MIN_SIZE_PX:
             raise ValueError(f"the pixel array is {self.width_px} x {self.height_px} px (active area "
                              f"{self.active_width_mm:g} x {self.active_height_mm:g} mm at {self.pixel_um:g} um); "
@@ -536,8 +518,8 @@ class ExposureSpec(SpecModel):
     ``mean_level``: the mean voltage of the central region at ``level`` of the swing;
     ``percentile``: the ``percentile``-th percentile of the central region at ``level``
     of the swing; ``hdr``: a long and a short exposure ``hdr_ratio`` apart, merged
-    before the ISP (:mod:`benchmark.camera.hdr`); ``fixed``: ``exposure_s``. All but ``fixed``
-    are capped at ``max_exposure_s``."""
+    before the ISP (:func:`benchmark.camera.acquisition.acquire_two_frames`); ``fixed``:
+    ``exposure_s``. All but ``fixed`` are capped at ``max_exposure_s``."""
 
     mode: Literal["auto_peak", "fixed", "mean_level", "percentile", "hdr"] = "auto_peak"
     level: float = Field(0.90, gt=0.0, le=1.0)
@@ -640,6 +622,13 @@ class CameraSpec(SpecModel):
     @property
     def f_number(self) -> float:
         return self.optics.f_number
+
+    @model_validator(mode="after")
+    def _one_acquisition(self) -> "CameraSpec":
+        if self.sensor.dcg is not None and self.exposure.mode == "hdr":
+            raise ValueError("exposure.mode 'hdr' (two frames) with sensor.dcg (an HDR pixel read in one exposure): "
+                             "give one of them")
+        return self
 
     @model_validator(mode="after")
     def _lens_does_not_fold(self) -> "CameraSpec":

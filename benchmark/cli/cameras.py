@@ -67,11 +67,13 @@ def list_command(as_json: bool = typer.Option(False, "--json", help="Print JSON.
 
 @app.command("show")
 def show_command(
-    name: str = typer.Argument(..., help="cam01..cam13, a number, or a YAML path."),
+    name: str = typer.Argument(..., help="cam01..cam13, an extra camera (auto-imx490-like), a number, or a YAML path."),
     as_json: bool = typer.Option(False, "--json", help="Print JSON."),
 ) -> None:
     """Show a camera's resolved spec (defaults filled in) and what it implies: field of
-    view, IFOV, Nyquist, saturation, dynamic range, SNR at 100 lux, warnings."""
+    view, IFOV, Nyquist, MTF50 through the whole chain, saturation, dynamic range, SNR at
+    100 lux, and the datasheet figures measured on its photon transfer (dynamic range,
+    SNR10 and SNR1 illuminance, HDR transitions); warnings."""
     from benchmark.camera.figures import camera_figures, camera_warnings, figure_rows
 
     cam = _load([name])[0]
@@ -106,7 +108,7 @@ def show_command(
 
 @app.command("mtf")
 def mtf_command(
-    names: Optional[list[str]] = typer.Argument(None, help="Cameras (default: all 13)."),
+    names: Optional[list[str]] = typer.Argument(None, help="Cameras (default: all 13; extra cameras by name)."),
     as_json: bool = typer.Option(False, "--json", help="Print JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the MTF curves to this image."),
     isp_name: Optional[str] = typer.Option(
@@ -147,7 +149,8 @@ def mtf_command(
             "fov_deg": [round(cam.hfov_deg, 2), round(cam.vfov_deg, 2)],
             "mtf50_cy_per_mm": round(m["mtf50_cy_per_mm"], 2),
             "mtf50_cy_per_mrad": _round(cam.cy_per_mrad(m["mtf50_cy_per_mm"]), 4),
-            "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(cam.pixel_um, cam.f_number), 2),
+            "mtf50_analytic_cy_per_mm": round(mtf50_analytic_cy_per_mm(
+                cam.pixel_um, cam.f_number, sensor_spec=cam.sensor, optics=cam.optics), 2),
             "mtf50_group": cam.mtf50_group_cy_per_mm,
             "nyquist_cy_per_mm": round(500.0 / cam.pixel_um, 2),
             "mtf50_cy_per_px": _round(m["mtf50_cy_per_px"], 4),
@@ -156,6 +159,7 @@ def mtf_command(
             "mtf10_cy_per_mm": _round(read["mtf10_cy_per_mm"], 2),
             "mtf10_cy_per_px": _round(read["mtf10_cy_per_px"], 4),
             **({"isp": isp_name or "camera", "esfr": esfr} if tagged else {}),
+            **({"chain": chain} if (chain := _chain(cam)) else {}),
         })
     if plot is not None:
         _plot(curves, plot)
@@ -182,6 +186,23 @@ def mtf_command(
     for r in results:
         per_px = ", ".join(f"MTF{n} {_cell(r[f'mtf{n}_cy_per_px'], '.3f')}" for n in (50, 30, 10))
         _out.print(f"{r['name']} in cycles/pixel (Nyquist 0.5): {per_px}", highlight=False)
+    for r in results:
+        if "chain" in r:
+            _out.print(f"{r['name']}: MTF50 through the whole chain: {r['chain']}", highlight=False)
+
+
+def _chain(cam: CameraSpec) -> str | None:
+    """What the edge goes through beyond a Bayer sensor read once (an HDR pixel's merge and
+    companding, a clear-pixel tile's demosaic and luminance), or None for such a sensor."""
+    from benchmark.camera.dual_gain import readouts
+
+    dcg, parts = cam.sensor.dcg, []
+    if dcg is not None:
+        parts.append(f"{' + '.join(r.name for r in readouts(cam.sensor))} readouts merged to {dcg.merged_bits} bits, "
+                     f"companded to {dcg.companded_bits} and decompanded")
+    if cam.sensor.cfa != "RGGB":
+        parts.append(f"{cam.sensor.cfa} demosaic ({cam.isp.demosaic}), luminance = the clear channel")
+    return "; ".join(parts) or None
 
 
 def _round(value: float | None, digits: int) -> float | None:

@@ -10,8 +10,10 @@ normalised at DC. The central difference and the 1/4-pixel bins are corrected
 Frequencies are cycles/mm on the sensor along the edge normal.
 
 The camera measurement renders :func:`benchmark.measure.targets.slanted_edge_scene` through the
-same optics, sensor (noise off, quantised) and demosaic as :func:`benchmark.camera.pipeline.simulate`,
-and analyses the luminance 0.3 R + 0.6 G + 0.1 B (ISETCam).
+same optics, sensor, acquisition (:func:`benchmark.camera.acquisition.acquire`, noise off:
+an HDR pixel's merge and companding included) and ISP (:func:`benchmark.camera.isp.white_balanced_rgb`:
+white balance and demosaic) as :func:`benchmark.camera.pipeline.simulate`, and analyses the
+luminance 0.3 R + 0.6 G + 0.1 B (ISETCam; the clear channel of an RCCB or RCCC sensor).
 
 ``measure_mtf50(camera, esfr="isetcam")`` measures as ISETCam did for the paper's MTF50
 groups (ISET/isetauto ``papers/EI2023/s_eiSensorFnumber.m``: ``ieISO12233(ip, sensor)``
@@ -29,8 +31,9 @@ import math
 import numpy as np
 import scipy.optimize
 
-from benchmark.camera import exposure, isp, sensor
-from benchmark.camera.calibration import illuminant_gains, illuminant_spectrum
+from benchmark.camera import isp, sensor
+from benchmark.camera.acquisition import acquire
+from benchmark.camera.calibration import calibrate, illuminant_spectrum
 from benchmark.camera.lens import lens_otf
 from benchmark.camera.pipeline import camera_extent, electron_rate
 from benchmark.camera.spec import CameraSpec, OpticsSpec, SensorSpec
@@ -38,6 +41,18 @@ from benchmark.measure.targets import slanted_edge_scene
 from metricscenes.spectral import WAVELENGTHS_NM
 
 LUMINANCE_WEIGHTS = np.array([0.3, 0.6, 0.1])
+"""The e-SFR's luminance of camera R, G, B (ISETCam)."""
+
+
+def luminance_weights(cfa: str = "RGGB") -> np.ndarray:
+    """Weights of the camera channels (:func:`benchmark.camera.sensor.cfa_channels`) in the
+    e-SFR's luminance: :data:`LUMINANCE_WEIGHTS` for a Bayer tile; the clear channel alone
+    for RCCB and RCCC, whose unfiltered pixels are the sensor's luminance samples (R and B
+    are sampled once per tile and carry colour, not detail)."""
+    channels = sensor.cfa_channels(cfa)
+    if "C" not in channels:
+        return LUMINANCE_WEIGHTS
+    return np.array([1.0 if c == "C" else 0.0 for c in channels])
 
 
 def esf_mtf(image: np.ndarray, *, oversample: int = 4) -> tuple[np.ndarray, np.ndarray]:
@@ -108,7 +123,7 @@ def luminance_weights_per_band(sensor_spec: SensorSpec, spectrum: np.ndarray) ->
     ``spectrum`` after white balance for it: w(λ) = Σ_c k_c g_c r_c(λ) S(λ), summing to 1."""
     resp = sensor.channel_responsivity(sensor_spec) * np.asarray(spectrum)[None, :]
     gains = resp.sum(1)[1] / resp.sum(1)
-    w = (LUMINANCE_WEIGHTS * gains) @ resp
+    w = (luminance_weights(sensor_spec.cfa) * gains) @ resp
     return w / w.sum()
 
 
@@ -290,16 +305,14 @@ def measure_mtf50(
         camera.width_px, camera.height_px, d65 * 1e-3, roi_px=roi_px, angle_deg=angle_deg, field=camera_extent(camera)
     )
     rate = sensor.mosaic(electron_rate(scene, camera, shape_px=roi_px, extent=extent), camera.sensor.cfa)
+    # The camera's own acquisition (its HDR pixel, merge and companding included), noise off,
+    # with the edge's peak at 90 % of the range; then its ISP up to the demosaicked channels.
     policy = camera.exposure.model_copy(update={"mode": "auto_peak", "level": 0.9, "region_fraction": 1.0})
-    exposure_s = exposure.exposure_time_s(rate, camera.sensor, policy)
-    raw = sensor.capture_dn(rate, exposure_s, camera.sensor, None, sensor.NoiseOptions.off())
-    lin = isp.raw_to_linear(raw, camera.sensor)
-    if camera.isp.white_balance == "none":
-        balanced = lin
-    else:
-        balanced = isp.apply_gains(lin, illuminant_gains(camera.sensor, "D65"), camera.sensor.cfa)
-    rgb = isp.demosaic(balanced, camera.isp.demosaic, camera.sensor.cfa)
-    lum = rgb @ LUMINANCE_WEIGHTS
+    raw = acquire(rate, camera.model_copy(update={"exposure": policy}), seed=0, noise=False)
+    processing = camera.isp if camera.isp.white_balance == "none" else camera.isp.model_copy(
+        update={"white_balance": "known_illuminant", "illuminant": "D65"})
+    rgb = isp.white_balanced_rgb(raw.linear_dn, camera.sensor, processing, calibrate(camera.sensor, processing))
+    lum = rgb @ luminance_weights(camera.sensor.cfa)
     pixel_mm = camera.pixel_um * 1e-3
     if iset:
         freq, mtf = esf_mtf_isetcam(lum[4:-4, 4:-4])  # drop the demosaic's border
