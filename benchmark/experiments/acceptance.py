@@ -35,6 +35,14 @@ def _spearman(x, y) -> float:
     return float(stats.spearmanr(x[ok], y[ok]).statistic)
 
 
+def _ap_by_camera(table: pd.DataFrame, condition: str) -> pd.DataFrame:
+    """AP of one condition, camera × distance (ValueError, one line, if the table has none)."""
+    rows = table[table["condition"] == condition]
+    if rows.empty:
+        raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
+    return rows.pivot_table(index="camera", columns="distance_m", values="ap")
+
+
 def ap_distance_rho(table: pd.DataFrame, condition: str = "day") -> pd.Series:
     """Spearman's rho of AP against distance, per camera, under ``condition`` (NaN where
     AP is constant or fewer than three distances have AP)."""
@@ -105,13 +113,7 @@ def night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day",
     - ``dusk_between_at_near``: night < dusk <= day AP at ``near_m`` for every camera
       (dusk may match day; ``dusk_between_cameras``: how many).
     """
-    def ap(condition: str) -> pd.DataFrame:
-        rows = table[table["condition"] == condition]
-        if rows.empty:
-            raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
-        return rows.pivot_table(index="camera", columns="distance_m", values="ap")
-
-    ap_day, ap_dusk, ap_night = ap(day), ap(dusk), ap(night)
+    ap_day, ap_dusk, ap_night = (_ap_by_camera(table, c) for c in (day, dusk, night))
     rhos = ap_distance_rho(table, night).to_numpy()
     worst = float(np.max(rhos)) if not np.any(np.isnan(rhos)) else float("nan")
     od_night = od50[od50["condition"] == night]["od50_m"].astype(float)
@@ -151,13 +153,7 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
     """
     from benchmark.experiments.sweep import with_censoring
 
-    def ap(condition: str) -> pd.DataFrame:
-        rows = table[table["condition"] == condition]
-        if rows.empty:
-            raise ValueError(f"table has no {condition!r} rows (conditions: {sorted(set(table['condition']))})")
-        return rows.pivot_table(index="camera", columns="distance_m", values="ap")
-
-    ap_day, ap_night = ap(day), ap(night)
+    ap_day, ap_night = _ap_by_camera(table, day), _ap_by_camera(table, night)
     rows = table[table["condition"] == night]
     od_night = with_censoring(od50[od50["condition"] == night], rows)
     lo, hi = float(rows["distance_m"].min()), float(rows["distance_m"].max())
