@@ -96,15 +96,10 @@ class SceneWeights:
 
     def __init__(self, collection: Collection, condition: str = "night"):
         self.collection, self.condition = collection, condition
-        self._luminance: dict[tuple[str, str], float] = {}
-
-    def group_luminance(self, scene_id: str, group: str) -> float:
-        if (scene_id, group) not in self._luminance:
-            self._luminance[scene_id, group] = self.collection.mean_luminance(scene_id, {group: 1.0})
-        return self._luminance[scene_id, group]
 
     def luminance(self, scene_id: str, weights: dict[str, float]) -> float:
-        return sum(w * self.group_luminance(scene_id, g) for g, w in weights.items() if w)
+        """Mean luminance of a mix, from the collection's cached per-group luminances (a mix is linear)."""
+        return sum(w * self.collection.group_luminance(scene_id, g) for g, w in weights.items() if w)
 
     def weights(self, scene_id: str, scene: str) -> dict[str, float]:
         night = self.collection.targeted_weights(scene_id, self.condition).weights
@@ -112,7 +107,7 @@ class SceneWeights:
             return dict(night)
         target = self.luminance(scene_id, night)
         lamps = {g: 1.0 for g in LAMPS} if scene == "day_lamps_matched" else {}
-        ambient = max(0.0, target - self.luminance(scene_id, lamps)) / self.group_luminance(scene_id, "sky_day")
+        ambient = max(0.0, target - self.luminance(scene_id, lamps)) / self.collection.group_luminance(scene_id, "sky_day")
         return {"sky_day": ambient, **lamps}
 
 

@@ -420,7 +420,7 @@ class Collection:
         cols, rows = self.reference_grid
         return float(radiance_to_xyz(self.radiance(scene_id, condition).resample(cols, rows))[..., 1].mean())
 
-    def _group_luminance(self, scene_id: str, group: str) -> float:
+    def group_luminance(self, scene_id: str, group: str) -> float:
         """:meth:`mean_luminance` of one light group at weight 1, kept per version of its files."""
         units = (f"plates/env{self._image(scene_id)['environment_id']:03d}", f"frames/{scene_id}", f"insets/{scene_id}")
         key = (str(self.root), scene_id, group,
@@ -438,8 +438,8 @@ class Collection:
         target = draw_target_lux(self.manifest.seed, env, condition, spec.target_image_plane_lux)
         lamps = {g: w for g, w in spec.lamps.items() if w != 0.0}
         try:
-            return ambient_weight(target, spec.f_number, self._group_luminance(scene_id, spec.ambient),
-                                  {g: self._group_luminance(scene_id, g) for g in lamps}, lamps, spec.ambient)
+            return ambient_weight(target, spec.f_number, self.group_luminance(scene_id, spec.ambient),
+                                  {g: self.group_luminance(scene_id, g) for g in lamps}, lamps, spec.ambient)
         except ValueError as exc:
             raise CollectionError(f"{self.root}: scene {scene_id}, condition {condition}: {exc}") from None
 
