@@ -16,7 +16,7 @@ def test_list_json():
     result = runner.invoke(app, ["list", "--json"])
     assert result.exit_code == 0
     rows = json.loads(result.stdout)
-    assert [r["name"] for r in rows][:2] == ["cam01", "cam02"] and len(rows) == 13
+    assert [r["name"] for r in rows][:2] == ["cam01", "cam02"] and len([r for r in rows if not r["extra"]]) == 13
     assert {"name", "pixel_um", "f_number", "label", "width_px", "height_px", "mtf50_group"} <= set(rows[0])
 
 

@@ -8,7 +8,8 @@ central region, t ≤ 16 ms (60 frames/s). Voltages here are signal volts at the
 Besides the reference (``auto_peak``) a run may choose ``mean_level``, ``percentile``,
 ``hdr`` (two exposures, :func:`benchmark.camera.acquisition.acquire_two_frames`) or
 ``fixed``; :func:`parse_exposure` reads the compact syntax of ``benchmark run/sweep
---exposure`` (docs/camera.md, "Acquisition policies").
+--exposure`` (docs/camera.md, "Acquisition policies") and :func:`check_exposure_override`
+refuses a policy that cannot replace a camera's own.
 """
 
 from __future__ import annotations
@@ -181,9 +182,24 @@ def exposure_tag(policy: ExposureSpec) -> str:
     return text.replace(":", "-").replace("@", "-level")
 
 
+def check_exposure_override(camera, policy: ExposureSpec | None) -> None:
+    """One-line ValueError if ``policy`` (an ``--exposure``) cannot replace ``camera``'s own:
+    the two-frame ``hdr`` policy on an HDR pixel (``sensor.dcg``), which merges its own
+    readouts in one exposure (two frames of it are not modelled). The CLI calls it where it
+    applies ``--exposure``, before anything runs: the capture refuses the pair too
+    (:func:`benchmark.camera.acquisition.acquire`), but only once a run has begun."""
+    if policy is None or policy.mode != "hdr" or camera.sensor.dcg is None:
+        return
+    raise ValueError(f"camera {camera.name!r}: --exposure {format_exposure(policy) or 'hdr'} takes two frames, but "
+                     "its sensor is an HDR pixel (sensor.dcg) that already merges its own readouts in one exposure: "
+                     "use the camera's own exposure policy (no --exposure) or a one-frame one (auto_peak, "
+                     "mean_level, percentile:P, fixed:SECONDS)")
+
+
 def with_exposure(camera, policy: ExposureSpec | None):
     """``camera`` with its exposure block replaced by ``policy`` (None: unchanged). The new
-    spec, hence its sha256 and results.json's ``camera.spec``, records the policy."""
+    spec, hence its sha256 and results.json's ``camera.spec``, records the policy. Not
+    validated (a model copy): :func:`check_exposure_override` refuses what does not apply."""
     if policy is None:
         return camera
     return camera.model_copy(update={"exposure": policy})

@@ -44,7 +44,7 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 
 def camera_names() -> list[str]:
     """Names of the paper's 13 cameras, in the paper's order: the registry that ``--cameras
-    all``, ``benchmark cameras list`` and the leaderboard mean."""
+    all`` and the leaderboard mean (``benchmark cameras list`` shows them, then the extras)."""
     return sorted(p.stem for p in DATA_DIR.glob("cam*.yaml"))
 
 

@@ -1,5 +1,8 @@
 """``benchmark cameras``: list, show and measure (MTF50) the registry's cameras.
 
+``list`` shows the paper's 13 and, after them, the packaged extra cameras (``auto-*``),
+marked ``extra``: loaded by name, never part of ``--cameras all``.
+
 Mounted by the main CLI as ``app.add_typer(cameras_app, name="cameras")``. Errors print
 one line and exit with code 2. Every MTF50 shown comes in cycles/mm on the sensor and in
 cycles/mrad in object space (× focal length / 1000: what compares cameras whose focal
@@ -16,7 +19,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from benchmark.camera import CameraSpec, list_cameras, load_camera
+from benchmark.camera import CameraSpec, extra_camera_names, list_cameras, load_camera
 from benchmark.cli.help import HELP_SETTINGS
 from metricscenes.cli_support import fail
 
@@ -32,9 +35,10 @@ def _load(names: list[str]) -> list[CameraSpec]:
         fail(str(exc))
 
 
-def _summary(cam: CameraSpec) -> dict:
+def _summary(cam: CameraSpec, *, extra: bool = False) -> dict:
     return {
         "name": cam.name,
+        "extra": extra,
         "label": cam.label,
         "pixel_um": cam.pixel_um,
         "f_number": cam.f_number,
@@ -50,19 +54,33 @@ def _summary(cam: CameraSpec) -> dict:
 
 @app.command("list")
 def list_command(as_json: bool = typer.Option(False, "--json", help="Print JSON.")) -> None:
-    """List the registry's cameras."""
-    rows = [_summary(c) for c in _load([])]
+    """List the registry's cameras: the paper's 13, then the extra cameras (marked extra:
+    loaded by name, not in --cameras all)."""
+    paper = [_summary(c) for c in _load([])]
+    extras = [_summary(c, extra=True) for c in _load(extra_camera_names())]
     if as_json:
-        print(json.dumps(rows, indent=2))
+        print(json.dumps(paper + extras, indent=2))
         return
-    table = Table(title="Cameras (MTF50 group: the paper's, cycles/mm on the sensor and cycles/mrad in object space)")
-    for col in ("name", "pixel µm", "f-number", "size px", "focal mm", "FOV °", "MTF50 group cy/mm", "cy/mrad", "sha256"):
+    table = Table(title="Cameras (MTF50 group: the paper's, cycles/mm on the sensor and cycles/mrad in object space)",
+                  caption="extra: packaged beside the paper's 13, loaded by name, not in --cameras all")
+    # the name whole however narrow the terminal: it is what `run --camera` takes
+    table.add_column("name", no_wrap=True, min_width=max(len(r["name"]) for r in paper + extras))
+    table.add_column("set", no_wrap=True, min_width=len("extra"))
+    for col in ("pixel µm", "f-number", "size px", "focal mm", "FOV °", "MTF50 group cy/mm", "cy/mrad", "sha256"):
         table.add_column(col)
-    for r in rows:
-        table.add_row(r["name"], f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}", f"{r['width_px']}x{r['height_px']}",
-                      f"{r['focal_length_mm']:g}", "{:.1f} x {:.1f}".format(*r["fov_deg"]), f"{r['mtf50_group'] or '-'}",
-                      _cell(r["mtf50_group_cy_per_mrad"], ".3f"), r["sha256"][:12])
+    for r in paper:
+        table.add_row(*_list_cells(r))
+    table.add_section()  # a rule between the 13 and the extras
+    for r in extras:
+        table.add_row(*_list_cells(r))
     _out.print(table)
+
+
+def _list_cells(r: dict) -> list[str]:
+    """A ``cameras list`` table row from a :func:`_summary`."""
+    return [r["name"], "extra" if r["extra"] else "paper", f"{r['pixel_um']:.1f}", f"{r['f_number']:.1f}",
+            f"{r['width_px']}x{r['height_px']}", f"{r['focal_length_mm']:g}", "{:.1f} x {:.1f}".format(*r["fov_deg"]),
+            f"{r['mtf50_group'] or '-'}", _cell(r["mtf50_group_cy_per_mrad"], ".3f"), r["sha256"][:12]]
 
 
 @app.command("show")

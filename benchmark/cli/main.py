@@ -93,7 +93,7 @@ def run(
     """Simulate one camera on a collection, detect cars, print AP per distance."""
     from benchmark.camera import load_camera
     from benchmark.detectors import DetectorError, load_detector
-    from benchmark.camera.exposure import format_exposure, parse_exposure, with_exposure
+    from benchmark.camera.exposure import check_exposure_override, format_exposure, parse_exposure, with_exposure
     from benchmark.experiments.run import check_out_dir, run_camera, subset_collection
     from metricscenes.outputs import RUN, check_output
     from metricscenes.store import Collection, CollectionError
@@ -102,7 +102,9 @@ def run(
         check_out_dir(out)
         check_output(out, "--out", own=RUN)  # a new folder or an earlier run's, never a sweep's or the leaderboard
         policy = parse_exposure(exposure) if exposure is not None else None
-        cam = with_exposure(load_camera(camera), policy)
+        cam = load_camera(camera)
+        check_exposure_override(cam, policy)  # before anything runs (the capture would refuse it mid-run)
+        cam = with_exposure(cam, policy)
         col = subset_collection(Collection.open(collection), environments, distances)
         check_condition(col, condition)
         detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map, model_dir=model_dir)
