@@ -72,6 +72,9 @@ class SpectralScene:
     wavelengths_nm: np.ndarray = field(default_factory=lambda: WAVELENGTHS_NM.copy())
     units: str = RADIANCE_UNITS
     metadata: dict = field(default_factory=dict)
+    # The last grid this scene was resampled onto and the result: cameras that share a pixel
+    # grid (the paper's 13 have six) read one composite, not one each.
+    _last_resample: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def extent(self) -> TanExtent:
@@ -98,9 +101,13 @@ class SpectralScene:
 
         The array is stored band by band (a (bands, rows, cols) C-contiguous block
         viewed as (rows, cols, bands)), so each band ``out[:, :, b]`` is one contiguous
-        image, as the per-band optics wants it.
+        image, as the per-band optics wants it. The array is read-only: the same grid asked
+        for again (another camera of the same pixel grid) returns it without recomputing.
         """
         extent = extent or self.extent
+        key = (int(cols), int(rows), extent.as_tuple())
+        if key in self._last_resample:
+            return self._last_resample[key]
         plate = self.layers[0]
         out = _apply(*_weights(plate, cols, rows, extent), plate.radiance)
         finer = (extent.width / cols < plate.pixel_tan[0] * (1 - 1e-9)
@@ -109,7 +116,10 @@ class SpectralScene:
             _paste(out, inset, cols, rows, extent, self.extent)
             if inset.sharp is not None and finer:
                 _match_plate(out, inset, plate, cols, rows, extent)
-        return out.transpose(1, 2, 0)
+        out.flags.writeable = False
+        self._last_resample.clear()  # one grid kept: a sweep takes its cameras grid by grid
+        self._last_resample[key] = out.transpose(1, 2, 0)
+        return self._last_resample[key]
 
 
 def on_grid_of(layer: RadianceLayer, target: RadianceLayer) -> np.ndarray:

@@ -150,6 +150,42 @@ def test_sweep_bytes_do_not_depend_on_the_workers(serial_collection, tmp_path):
 
 
 @pytest.mark.slow
+def test_cameras_run_together_write_what_each_writes_alone(serial_collection, tmp_path, monkeypatch):
+    """run_cameras reads each scene once and resamples it once per pixel grid (small-a and its
+    f/4 twin share one): every camera's files are those of its own run_camera, byte for byte."""
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.camera import load_camera
+    from benchmark.detectors import load_detector
+    from benchmark.experiments import run as run_module
+    from metricscenes.radiance import SpectralScene
+    from metricscenes.store import Collection
+
+    twin = tmp_path / "small-a-f4.yaml"
+    twin.write_text("name: small-a-f4\noptics: {f_number: 4.0}\nsensor: {pixel_um: 11.2}\n")
+    cameras = [*_small_cameras(tmp_path), load_camera(twin)]
+    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
+    collection = Collection.open(serial_collection)
+    alone = [run_module.run_camera(collection, c, "day", detector, tmp_path / "alone" / c.name) for c in cameras]
+    composites = []
+    original = SpectralScene.resample
+
+    def counted(scene, cols, rows, extent=None):
+        composites.append((id(scene), cols, rows, scene._last_resample.get((cols, rows, (extent or scene.extent).as_tuple())) is None))
+        return original(scene, cols, rows, extent)
+
+    monkeypatch.setattr(SpectralScene, "resample", counted)
+    together = run_module.run_cameras(collection, cameras, "day", detector, [tmp_path / "together" / c.name for c in cameras])
+    assert [r.detections_sha256 for r in together] == [r.detections_sha256 for r in alone]
+    for camera in cameras:
+        assert _sweep_files(tmp_path / "together" / camera.name) == _sweep_files(tmp_path / "alone" / camera.name)
+    n_scenes = len(collection.scenes())
+    grids = {(c.width_px, c.height_px) for c in cameras}
+    composites = [c for c in composites if c[1:3] in grids]  # (not the MTF target's, measured for results.json)
+    assert len(composites) == 3 * n_scenes and len({scene for scene, *_ in composites}) == n_scenes  # one read a scene
+    assert sum(computed for *_, computed in composites) == 2 * n_scenes  # two grids: the twin's is reused
+
+
+@pytest.mark.slow
 def test_a_sweep_on_another_sweeps_captures_detects_the_same(serial_collection, tmp_path, monkeypatch):
     """--captures-from: a 640 sweep that detects on a native sweep's images writes what a 640
     sweep that simulates the cameras writes, without simulating them; a capture of another

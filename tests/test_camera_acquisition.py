@@ -321,7 +321,9 @@ def test_cli_run_overrides_the_camera_exposure(fakes, monkeypatch):  # noqa: F81
 
         return fake_run_camera(collection, camera, condition, detector, out_dir, **kw)
 
-    monkeypatch.setattr("benchmark.experiments.run.run_camera", run_camera)
+    from test_sweep_cache import patch_runs
+
+    patch_runs(monkeypatch, run_camera)
     result = CliRunner().invoke(app, ["run", "--camera", "cam05", "--collection", str(fakes), "--out",
                                       str(fakes / "r"), "--exposure", "percentile:95@0.5"])
     assert result.exit_code == 0, result.output

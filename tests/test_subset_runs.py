@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 from benchmark.camera import load_camera
 from benchmark.cli.main import app
 from benchmark.experiments.run import CollectionSubset, parse_subset, run_camera, subset_collection
-from test_sweep_cache import N_ENV, FakeCollection, FakeDetector, fake_run_camera
+from test_sweep_cache import N_ENV, FakeCollection, FakeDetector, fake_run_camera, patch_runs
 
 
 def _lines(output: str) -> list[str]:
@@ -73,7 +73,7 @@ def fakes(monkeypatch, tmp_path):
             write_results(args[3] / "results.json", results)
         return results
 
-    monkeypatch.setattr("benchmark.experiments.run.run_camera", run)
+    patch_runs(monkeypatch, run)
     monkeypatch.setattr(metricscenes.store.Collection, "open", classmethod(lambda cls, path: FakeCollection(tmp_path)))
     monkeypatch.setattr(benchmark.detectors, "load_detector", lambda model, **kw: FakeDetector(name=model))
     return tmp_path

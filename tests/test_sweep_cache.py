@@ -148,6 +148,24 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
     return results
 
 
+def run_cameras_one_by_one(collection, cameras, condition, detector, out_dirs, *, captures=None, **kwargs):
+    """``run_cameras`` as a loop over ``benchmark.experiments.run.run_camera`` (looked up when
+    called), so that a test's fake ``run_camera`` stands for every camera a sweep groups."""
+    from benchmark.experiments import run as run_module
+
+    captures = captures or [None] * len(cameras)
+    progress = kwargs.pop("progress", None)  # scenes of the whole group: the last camera reports them
+    return [run_module.run_camera(collection, camera, condition, detector, out_dir, captures=c,
+                                  progress=progress if k == len(cameras) - 1 else None, **kwargs)
+            for k, (camera, out_dir, c) in enumerate(zip(cameras, out_dirs, captures))]
+
+
+def patch_runs(monkeypatch, run) -> None:
+    """Every run of a sweep goes to ``run`` (a fake ``run_camera``)."""
+    monkeypatch.setattr("benchmark.experiments.run.run_camera", run)
+    monkeypatch.setattr("benchmark.experiments.run.run_cameras", run_cameras_one_by_one)
+
+
 class CountingRun:
     """fake_run_camera that counts its calls and can die after ``die_after`` calls."""
 
@@ -167,7 +185,7 @@ CAMERAS = ("cam01", "cam12")
 
 def make_fake_sweep(out: Path, monkeypatch, *, run=None, cameras=CAMERAS, conditions=("day", "night"), **kw):
     """A sweep folder from the fake runs (public helper for the report tests)."""
-    monkeypatch.setattr("benchmark.experiments.run.run_camera", run or fake_run_camera)
+    patch_runs(monkeypatch, run or fake_run_camera)
     kw.setdefault("n_resamples", 50)
     kw.setdefault("mtf_source", "analytic")
     kw.setdefault("save_images", False)  # the report tests ask for them
@@ -237,11 +255,13 @@ def test_killed_sweep_resumes_and_equals_uninterrupted(tmp_path, monkeypatch):
     killed = CountingRun(die_after=2)
     with pytest.raises(KeyboardInterrupt):
         make_fake_sweep(tmp_path / "resumed", monkeypatch, run=killed)
-    (tmp_path / "resumed" / "runs" / "cam12-day").mkdir()  # a half-started run folder
-    (tmp_path / "resumed" / "runs" / "cam12-day" / "results.json").write_text('{"camera": ')
+    assert len(killed.calls) == 2
+    damaged = killed.calls[0]  # a finished run whose results.json was cut short
+    (tmp_path / "resumed" / "runs" / "-".join(damaged) / "results.json").write_text('{"camera": ')
     resumed = CountingRun()
     table = make_fake_sweep(tmp_path / "resumed", monkeypatch, run=resumed)
-    assert resumed.calls == [("cam12", "day"), ("cam12", "night")]
+    every = {(camera, condition) for camera in CAMERAS for condition in ("day", "night")}
+    assert sorted(resumed.calls) == sorted(every - set(killed.calls[1:]))  # the rest, and the damaged one again
     pd.testing.assert_frame_equal(table, full)
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "resumed" / "od50.csv"), pd.read_csv(tmp_path / "full" / "od50.csv"))
 

@@ -7,7 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from benchmark.cli.main import app
-from test_sweep_cache import FakeCollection, FakeDetector, fake_run_camera
+from test_sweep_cache import FakeCollection, FakeDetector, fake_run_camera, patch_runs
 
 
 @pytest.fixture
@@ -15,7 +15,7 @@ def fakes(monkeypatch, tmp_path):
     import benchmark.detectors
     import metricscenes.store
 
-    monkeypatch.setattr("benchmark.experiments.run.run_camera", fake_run_camera)
+    patch_runs(monkeypatch, fake_run_camera)
     monkeypatch.setattr(metricscenes.store.Collection, "open", classmethod(lambda cls, path: FakeCollection(tmp_path)))
     monkeypatch.setattr(benchmark.detectors, "load_detector", lambda model, **kw: FakeDetector(name=model))
     return tmp_path

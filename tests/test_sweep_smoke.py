@@ -29,6 +29,7 @@ def test_smoke_sweep_is_cached_and_reported(smoke_collection, tmp_path, monkeypa
         raise AssertionError("a cached run was recomputed")
 
     monkeypatch.setattr("benchmark.experiments.run.run_camera", no_run)
+    monkeypatch.setattr("benchmark.experiments.run.run_cameras", no_run)
     again = sweep.sweep(smoke_collection, [load_camera("cam01")], ["day", "night"], detector, out, n_resamples=20)
     pd.testing.assert_frame_equal(again, table)
 

@@ -135,7 +135,7 @@ def fixed_pattern(sensor: SensorSpec, shape: tuple[int, int], photodiode: int = 
                           int(photodiode))
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=16)  # (a sweep's cameras, scene by scene)
 def _fixed_pattern(fpn_seed: int, prnu_fraction: float, dsnu_v: float, shape: tuple[int, int], photodiode: int = 0):
     rng = np.random.default_rng([fpn_seed, 0x5E45] + ([photodiode] if photodiode else []))
     gain = 1.0 + prnu_fraction * rng.standard_normal(shape, dtype=np.float32)

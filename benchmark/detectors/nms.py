@@ -29,14 +29,16 @@ def box_iou(a_xyxy: np.ndarray, b_xyxy: np.ndarray) -> np.ndarray:
         return np.where(union > 0, inter / union, 0.0)
 
 
-def nms(boxes_xyxy: np.ndarray, scores: np.ndarray, iou_threshold: float) -> np.ndarray:
-    """Indices of the kept boxes, best score first (``torchvision.ops.nms``)."""
+def nms(boxes_xyxy: np.ndarray, scores: np.ndarray, iou_threshold: float, max_keep: int | None = None) -> np.ndarray:
+    """Indices of the kept boxes, best score first (``torchvision.ops.nms``); with
+    ``max_keep``, the first ``max_keep`` of them (greedy suppression never revisits a kept
+    box, so stopping there changes none of them: the same as cutting the full list)."""
     boxes = np.asarray(boxes_xyxy, dtype=np.float64).reshape(-1, 4)
     order = np.argsort(-np.asarray(scores, dtype=np.float64), kind="stable")
     x1, y1, x2, y2 = boxes.T
     areas = (x2 - x1) * (y2 - y1)
     keep: list[int] = []
-    while order.size:
+    while order.size and (max_keep is None or len(keep) < max_keep):
         i = order[0]
         keep.append(int(i))
         rest = order[1:]
@@ -64,5 +66,4 @@ def batched_nms(
     # YOLOv5 uses max_wh = 7680; a larger offset is needed only if boxes reach that far.
     offset = max(YOLOV5_MAX_WH, float(np.abs(boxes).max()) * 2.0 + 1.0)
     shifted = boxes + np.asarray(class_ids, dtype=np.float64)[:, None] * offset
-    keep = nms(shifted, scores, iou_threshold)
-    return keep if max_det is None else keep[:max_det]
+    return nms(shifted, scores, iou_threshold, max_keep=max_det)

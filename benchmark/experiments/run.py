@@ -330,28 +330,62 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     run on the same folder is refused (:class:`~metricscenes.lock.LockError`), and removes the
     staging folders that killed runs left there.
     """
+    return run_cameras(collection, [camera], condition, detector, [out_dir], seed=seed, save_images=save_images,
+                       backend=backend, progress=progress, captures=[captures])[0]
+
+
+def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed: int = 0,
+                save_images: bool = True, backend: str = "faster-coco-eval", progress=None,
+                captures=None) -> list[RunResults]:
+    """:func:`run_camera` for several cameras at once, scene by scene: each scene's radiance
+    is read once for all of them, and resampled once per pixel grid (the cameras are taken
+    grid by grid; :meth:`metricscenes.radiance.SpectralScene.resample` keeps the last).
+    Each camera's outputs are those :func:`run_camera` writes for it alone, byte for byte
+    (``results.json``'s ``timing_s`` aside, where ``read_radiance`` is the shared read).
+
+    ``out_dirs``: one folder per camera; ``captures``: None, or one entry per camera (None or
+    a run folder, as :func:`run_camera` takes it). ``progress`` ``(done, total)`` counts
+    scenes. The runs succeed or fail together: a failure leaves every folder as it was.
+    """
+    from contextlib import ExitStack
+
     from benchmark.camera.pipeline import camera_window
     from metricscenes.lock import output_lock
 
-    out_dir = check_out_dir(out_dir)  # before anything is written
+    cameras = list(cameras)
+    captures = [None] * len(cameras) if captures is None else list(captures)
+    if not (len(out_dirs) == len(captures) == len(cameras)):
+        raise ValueError("run_cameras needs one output folder (and one captures entry) per camera")
+    out_dirs = [check_out_dir(d) for d in out_dirs]  # before anything is written
+    if len({d.resolve() for d in out_dirs}) != len(out_dirs):
+        raise ValueError("run_cameras needs a distinct output folder per camera")
     field = collection_field(collection)
-    window = camera_window(camera, field)  # a camera wider than the collection: refused here
-    captured = None if captures is None else read_captures(captures, camera, condition, collection, seed)
-    created = [p for p in (out_dir, *out_dir.parents) if not p.exists()]
-    out_dir.mkdir(parents=True, exist_ok=True)
+    windows = [camera_window(camera, field) for camera in cameras]  # a camera wider than the collection: refused here
+    captured = [None if c is None else (Path(c), read_captures(c, camera, condition, collection, seed))
+                for camera, c in zip(cameras, captures)]
+    created = [[p for p in (d, *d.parents) if not p.exists()] for d in out_dirs]
     try:
-        with output_lock(out_dir, "benchmark run", "run folder"):
-            remove_stale_stages(out_dir)
-            return _staged(out_dir, lambda stage: _run_camera(
-                collection, camera, condition, detector, stage, field, window, seed=seed, save_images=save_images,
-                backend=backend, progress=progress, captures=None if captures is None else (Path(captures), captured)),
-                save_images)
+        with ExitStack() as held:
+            for d in out_dirs:
+                d.mkdir(parents=True, exist_ok=True)
+                held.enter_context(output_lock(d, "benchmark run", "run folder"))
+                remove_stale_stages(d)
+            stages = [Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=d)) for d in out_dirs]
+            held.callback(lambda: [shutil.rmtree(stage, ignore_errors=True) for stage in stages])
+            runs = [_CameraRun(collection, camera, condition, detector, stage, field, window, seed=seed,
+                               save_images=save_images, backend=backend, captures=c)
+                    for camera, stage, window, c in zip(cameras, stages, windows, captured)]
+            results = _run_scenes(collection, condition, runs, progress)
+            for d, stage in zip(out_dirs, stages):
+                _move_into_place(stage, d, save_images)
+            return results
     except BaseException:
-        for folder in created:  # the folders this run made, innermost first, if still empty
-            try:
-                folder.rmdir()
-            except OSError:
-                break
+        for folders in created:  # the folders these runs made, innermost first, if still empty
+            for folder in folders:
+                try:
+                    folder.rmdir()
+                except OSError:
+                    break
         raise
 
 
@@ -367,139 +401,170 @@ def remove_stale_stages(out_dir: Path) -> list[Path]:
     return stale
 
 
-def _staged(out_dir: Path, work, save_images: bool) -> RunResults:
-    """``work(stage)`` in a fresh staging folder inside ``out_dir``, its outputs then moved
-    into place one rename a file: images, detections and ground truth, then results.json
-    last (a sweep takes a run folder with its results.json as finished). The stage is
-    removed however it ends."""
-    stage = Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=out_dir))
-    try:
-        results = work(stage)
-        if save_images:
-            (out_dir / "images").mkdir(exist_ok=True)
-            for image in sorted((stage / "images").iterdir()):
-                os.replace(image, out_dir / "images" / image.name)
-        for name in ("detections.json", "groundtruth.json", "results.json"):
-            os.replace(stage / name, out_dir / name)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
-    return results
+def _move_into_place(stage: Path, out_dir: Path, save_images: bool) -> None:
+    """A finished run's outputs from its staging folder into ``out_dir``, one rename a file:
+    images, detections and ground truth, then results.json last (a sweep takes a run folder
+    with its results.json as finished)."""
+    if save_images:
+        (out_dir / "images").mkdir(exist_ok=True)
+        for image in sorted((stage / "images").iterdir()):
+            os.replace(image, out_dir / "images" / image.name)
+    for name in ("detections.json", "groundtruth.json", "results.json"):
+        os.replace(stage / name, out_dir / name)
 
 
-def _run_camera(collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
-                save_images: bool, backend: str, progress, captures: tuple[Path, RunResults] | None) -> RunResults:
-    """:func:`run_camera`'s work, writing into ``stage``; ``window`` is the part of the
-    collection's ``field`` the camera samples (and its ground truth follows); ``captures``:
-    (folder, results) of the run whose images stand for the camera's."""
-    from PIL import Image
+def grid_key(camera) -> tuple:
+    """What a camera's resampled radiance depends on besides the scene: its pixel grid,
+    field and distortion (cameras with equal keys share one resample)."""
+    return (camera.width_px, camera.height_px, camera.pixel_um, camera.optics.focal_length_mm,
+            camera.optics.distortion)
 
-    from benchmark.camera.pipeline import lens_mapping, simulate
-    from benchmark.detectors import coco_category_id
-    from benchmark.scoring import ap_by_distance, od50
-    from metricscenes import __version__
-    from metricscenes.store import scale_groundtruth
 
-    geometry = _geometry_record(camera, field, window)
-    (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
+def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) -> list[RunResults]:
+    """Every scene through every run, the radiance read once per scene (only where a run
+    simulates its camera); then each run scored. Runs of one pixel grid go one after
+    another, so the scene's last resample serves them all."""
+    order = sorted(range(len(runs)), key=lambda k: (str(grid_key(runs[k].camera)), k))
     scenes = collection.scenes()
-    timings = Timings()
-    detections: list[dict] = []
-    exposures: dict[str, float] = {}
-    short_exposures: dict[str, float] = {}  # the hdr policy's second frame
-    targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
     for i, scene in enumerate(scenes):
-        record = collection.condition_record(scene.scene_id, condition)
-        if record is not None:
-            targeted[scene.scene_id] = record
-        if captures is None:
+        radiance, read_s = None, 0.0
+        if any(run.captures is None for run in runs):
             t = time.perf_counter()
             radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
-            timings.add("read_radiance", t)
+            read_s = time.perf_counter() - t
+        for k in order:
+            runs[k].add(scene, radiance, read_s)
+        if progress:
+            progress(i + 1, len(scenes))
+    return [run.finish() for run in runs]
+
+
+class _CameraRun:
+    """One camera's run in its staging folder: :meth:`add` takes the scenes one by one
+    (simulate or read the captured image, detect, save), :meth:`finish` scores them and
+    writes detections, ground truth and results.json there. ``window`` is the part of the
+    collection's ``field`` the camera samples (and its ground truth follows); ``captures``:
+    (folder, results) of the run whose images stand for the camera's."""
+
+    def __init__(self, collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
+                 save_images: bool, backend: str, captures: tuple[Path, RunResults] | None):
+        self.collection, self.camera, self.condition, self.detector = collection, camera, condition, detector
+        self.stage, self.field, self.window = stage, field, window
+        self.seed, self.save_images, self.backend, self.captures = seed, save_images, backend, captures
+        (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
+        self.timings = Timings()
+        self.detections: list[dict] = []
+        self.exposures: dict[str, float] = {}
+        self.short_exposures: dict[str, float] = {}  # the hdr policy's second frame
+        self.targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
+
+    def add(self, scene, radiance, read_s: float) -> None:
+        """One scene: ``radiance`` its :class:`~metricscenes.radiance.SpectralScene` under the
+        condition (None where this run detects on captured images), read in ``read_s`` s."""
+        from PIL import Image
+
+        from benchmark.camera.pipeline import simulate
+        from benchmark.detectors import coco_category_id
+
+        camera, captures, timings = self.camera, self.captures, self.timings
+        record = self.collection.condition_record(scene.scene_id, self.condition)
+        if record is not None:
+            self.targeted[scene.scene_id] = record
+        if captures is None:
+            timings.seconds["read_radiance"] = timings.seconds.get("read_radiance", 0.0) + read_s
             t = time.perf_counter()
-            capture = simulate(radiance, camera, seed=scene_seed(seed, scene.image_id))
+            capture = simulate(radiance, camera, seed=scene_seed(self.seed, scene.image_id))
             timings.add("camera", t)
-            rgb8, exposures[scene.scene_id] = capture.rgb8, capture.exposure_s
+            rgb8, self.exposures[scene.scene_id] = capture.rgb8, capture.exposure_s
             if capture.exposure_short_s is not None:
-                short_exposures[scene.scene_id] = capture.exposure_short_s
+                self.short_exposures[scene.scene_id] = capture.exposure_short_s
         else:
             t = time.perf_counter()
             rgb8 = _captured_image(captures[0], scene.scene_id, camera)
-            exposures[scene.scene_id] = captures[1].exposure_s[scene.scene_id]
+            self.exposures[scene.scene_id] = captures[1].exposure_s[scene.scene_id]
             if captures[1].exposure_short_s is not None:
-                short_exposures[scene.scene_id] = captures[1].exposure_short_s[scene.scene_id]
+                self.short_exposures[scene.scene_id] = captures[1].exposure_short_s[scene.scene_id]
             timings.add("read_captures", t)
         t = time.perf_counter()
         # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
-        (found,) = detector.detect([rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
+        (found,) = self.detector.detect([rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
         timings.add("detect", t)
         for d in found:
             x1, y1, x2, y2 = (float(v) for v in d.box_xyxy)
-            detections.append({
+            self.detections.append({
                 "image_id": scene.image_id, "category_id": coco_category_id(d.class_id),
                 "bbox": [round(x1, 3), round(y1, 3), round(x2 - x1, 3), round(y2 - y1, 3)],
                 "score": round(float(d.score), 6),
             })
-        if save_images:
+        if self.save_images:
             t = time.perf_counter()
+            image = self.stage / "images" / f"{scene.scene_id}.png"
             if captures is None:
-                Image.fromarray(rgb8).save(stage / "images" / f"{scene.scene_id}.png", compress_level=1)
+                Image.fromarray(rgb8).save(image, compress_level=1)
             else:
-                shutil.copyfile(captures[0] / "images" / f"{scene.scene_id}.png", stage / "images" / f"{scene.scene_id}.png")
+                shutil.copyfile(captures[0] / "images" / f"{scene.scene_id}.png", image)
             timings.add("save_images", t)
-        if progress:
-            progress(i + 1, len(scenes))
 
-    sensor_window, to_sensor = lens_mapping(camera, field)
-    groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
-                                    field=field, window=sensor_window, to_sensor=to_sensor)
-    t = time.perf_counter()
-    per_distance = ap_by_distance(groundtruth, detections, backend=backend)
-    timings.add("score", t)
-    detections_bytes = json.dumps(detections, separators=(",", ":")).encode()
-    per_distance = [DistanceAP(**row) for row in per_distance]
-    detector_record = DetectorRecord(name=detector.name, family=detector.family, sha256=detector.sha256,
-                                     input_size=detector.input_size, score_threshold=AP_SCORE_THRESHOLD, multi_label=True)
-    class_map = getattr(detector, "class_map", None)
-    if class_map is not None:  # a detector with other classes than COCO's 80 (docs/detection.md)
-        from benchmark.detectors.classmap import class_map_names
+    def finish(self) -> RunResults:
+        from benchmark.camera.pipeline import lens_mapping
+        from benchmark.scoring import ap_by_distance, od50
+        from metricscenes import __version__
+        from metricscenes.store import scale_groundtruth
 
-        detector_record.class_map = class_map_names(class_map)
-    results = RunResults(
-        format=RESULTS_FORMAT,
-        package_version=__version__,
-        numerics=numeric_provenance(),
-        composite=COMPOSITE,
-        camera=camera_record(camera),
-        condition=condition,
-        detector=detector_record,
-        collection=CollectionRecord(name=collection.name, protocol=collection.protocol,
-                                    manifest_sha256=collection.manifest_sha256, path=str(collection.root)),
-        seed=seed,
-        scoring_backend=backend,
-        per_distance=per_distance,
-        od50_m=_finite_or_none(od50([r.distance_m for r in per_distance], [r.ap for r in per_distance])),
-        exposure_s=exposures,
-        detections_file="detections.json",
-        detections_sha256=sha256_bytes(detections_bytes),
-        timing_s={k: round(v, 3) for k, v in timings.seconds.items()},
-    )
-    # The optional fields are set only where they apply, so that other results keep their bytes
-    # (results.json holds the fields set: benchmark.result_files).
-    if targeted:
-        results.condition_weights = targeted
-    if geometry is not None:  # a camera that sees a window of the field
-        results.camera_geometry = CameraGeometry(**geometry)
-    subset = getattr(collection, "subset", None)
-    if subset:  # a quick try on part of the collection: never a full run (sweep key, `benchmark submit`)
-        results.subset = Subset(**subset)
-    if short_exposures:  # hdr only; exposure_s holds the long frames
-        results.exposure_short_s = short_exposures
-    if captures is not None:  # detected on an earlier run's images
-        results.captures_from = str(captures[0])
-    (stage / "detections.json").write_bytes(detections_bytes)
-    (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
-    write_results(stage / "results.json", results)
-    return results
+        collection, camera, detector, stage, timings = self.collection, self.camera, self.detector, self.stage, self.timings
+        geometry = _geometry_record(camera, self.field, self.window)
+        sensor_window, to_sensor = lens_mapping(camera, self.field)
+        groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
+                                        field=self.field, window=sensor_window, to_sensor=to_sensor)
+        t = time.perf_counter()
+        per_distance = ap_by_distance(groundtruth, self.detections, backend=self.backend)
+        timings.add("score", t)
+        detections_bytes = json.dumps(self.detections, separators=(",", ":")).encode()
+        per_distance = [DistanceAP(**row) for row in per_distance]
+        detector_record = DetectorRecord(name=detector.name, family=detector.family, sha256=detector.sha256,
+                                         input_size=detector.input_size, score_threshold=AP_SCORE_THRESHOLD,
+                                         multi_label=True)
+        class_map = getattr(detector, "class_map", None)
+        if class_map is not None:  # a detector with other classes than COCO's 80 (docs/detection.md)
+            from benchmark.detectors.classmap import class_map_names
+
+            detector_record.class_map = class_map_names(class_map)
+        results = RunResults(
+            format=RESULTS_FORMAT,
+            package_version=__version__,
+            numerics=numeric_provenance(),
+            composite=COMPOSITE,
+            camera=camera_record(camera),
+            condition=self.condition,
+            detector=detector_record,
+            collection=CollectionRecord(name=collection.name, protocol=collection.protocol,
+                                        manifest_sha256=collection.manifest_sha256, path=str(collection.root)),
+            seed=self.seed,
+            scoring_backend=self.backend,
+            per_distance=per_distance,
+            od50_m=_finite_or_none(od50([r.distance_m for r in per_distance], [r.ap for r in per_distance])),
+            exposure_s=self.exposures,
+            detections_file="detections.json",
+            detections_sha256=sha256_bytes(detections_bytes),
+            timing_s={k: round(v, 3) for k, v in timings.seconds.items()},
+        )
+        # The optional fields are set only where they apply, so that other results keep their bytes
+        # (results.json holds the fields set: benchmark.result_files).
+        if self.targeted:
+            results.condition_weights = self.targeted
+        if geometry is not None:  # a camera that sees a window of the field
+            results.camera_geometry = CameraGeometry(**geometry)
+        subset = getattr(collection, "subset", None)
+        if subset:  # a quick try on part of the collection: never a full run (sweep key, `benchmark submit`)
+            results.subset = Subset(**subset)
+        if self.short_exposures:  # hdr only; exposure_s holds the long frames
+            results.exposure_short_s = self.short_exposures
+        if self.captures is not None:  # detected on an earlier run's images
+            results.captures_from = str(self.captures[0])
+        (stage / "detections.json").write_bytes(detections_bytes)
+        (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
+        write_results(stage / "results.json", results)
+        return results
 
 
 def camera_record(camera) -> CameraRecord:

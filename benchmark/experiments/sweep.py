@@ -1,16 +1,18 @@
 """Every camera × condition on one collection: a tidy AP table and OD50 ± SD per run.
 
-Each (camera, condition) pair is one :func:`benchmark.experiments.run.run_camera` call in
-``out_dir/runs/<camera>-<condition>/`` (``<camera>-<condition>+<policy>/`` where a
-``--exposure`` policy changed the camera's own, e.g. ``cam01-day+hdr-16``, so that sweeps
+Each (camera, condition) pair is one run in ``out_dir/runs/<camera>-<condition>/``
+(``<camera>-<condition>+<policy>/`` where a ``--exposure`` policy changed the camera's own, e.g. ``cam01-day+hdr-16``, so that sweeps
 of several policies share one folder without overwriting). Runs are cached: a run folder whose
 ``results.json`` carries the same key — camera spec sha256, condition, detector sha256
 and input size, collection manifest sha256, seed — is reused, not recomputed.
 A collection subset (:class:`benchmark.experiments.run.CollectionSubset`, ``--environments`` /
 ``--distances``) adds ``subset`` to the key and ``+subset-<hash>`` to the folder name.
-``run_camera`` writes ``results.json`` last, so a sweep that was killed resumes with
-only its missing (or stale) runs. Those runs may go to worker processes or a dask cluster
-(``workers``, ``scheduler``: :mod:`metricscenes.backends`); each writes only its own run
+A run writes ``results.json`` last, so a sweep that was killed resumes with
+only its missing (or stale) runs. A condition's missing runs are done together, scene by
+scene (:func:`benchmark.experiments.run.run_cameras`: each scene read once, resampled once per
+pixel grid), in as many groups of cameras as the backend runs at once (:func:`camera_groups`);
+a group killed midway is redone whole. The groups may go to worker processes or a dask cluster
+(``workers``, ``scheduler``: :mod:`metricscenes.backends`); each run writes only its own run
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
 do not depend on where the runs ran.
 
@@ -153,18 +155,39 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     return out
 
 
-def compute_run(collection, camera, condition: str, detector, run_dir: Path, seed: int, save_images: bool,
-                backend: str, n_resamples: int, progress=None, captures: Path | None = None) -> tuple[str, str, RunResults]:
-    """One (camera, condition) run and its bootstrap OD50, in whichever process the sweep's
-    backend gives it: everything it writes is in ``run_dir`` (``od50.json`` too), which no
-    other unit touches (``captures``, another sweep's run folder, is only read). Returns
-    (camera name, condition, results)."""
+def compute_runs(collection, cameras: list, condition: str, detector, run_dirs: list[Path], seed: int,
+                 save_images: bool, backend: str, n_resamples: int, progress=None,
+                 captures: list[Path | None] | None = None) -> list[tuple[str, str, RunResults]]:
+    """Several cameras' runs under one condition (:func:`benchmark.experiments.run.run_cameras`:
+    each scene read once for all of them) and their bootstrap OD50s, in whichever process the
+    sweep's backend gives them: everything they write is in ``run_dirs`` (``od50.json`` too),
+    which no other unit touches (``captures``, another sweep's run folders, are only read).
+    Returns (camera name, condition, results) per camera."""
     from benchmark.experiments import run as run_module
 
-    results = run_module.run_camera(collection, camera, condition, detector, run_dir, seed=seed,
-                                    save_images=save_images, backend=backend, progress=progress, captures=captures)
-    run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
-    return camera.name, condition, results
+    results = run_module.run_cameras(collection, cameras, condition, detector, run_dirs, seed=seed,
+                                     save_images=save_images, backend=backend, progress=progress, captures=captures)
+    for run_dir in run_dirs:
+        run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
+    return [(camera.name, condition, r) for camera, r in zip(cameras, results)]
+
+
+def camera_groups(cameras: list, n_groups: int) -> list[list]:
+    """The cameras split into at most ``n_groups`` groups of about equal pixel counts (largest
+    first, each to the lightest group), cameras of one pixel grid always together so that a
+    scene's resample serves them all; deterministic, cameras in their given order within a grid."""
+    from benchmark.experiments.run import grid_key
+
+    grids: dict[tuple, list] = {}
+    for camera in cameras:
+        grids.setdefault(grid_key(camera), []).append(camera)
+    groups: list[list] = [[] for _ in range(max(1, min(n_groups, len(grids))))]
+    load = [0] * len(groups)
+    for same_grid in sorted(grids.values(), key=lambda cs: -sum(c.width_px * c.height_px for c in cs)):
+        lightest = load.index(min(load))
+        groups[lightest].extend(same_grid)
+        load[lightest] += sum(c.width_px * c.height_px for c in same_grid)
+    return [g for g in groups if g]
 
 
 def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, out_dir, *, seed: int = 0,
@@ -205,7 +228,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.experiments import run as run_module
     from benchmark.camera.pipeline import camera_window
     from benchmark.camera import load_camera
-    from benchmark.camera.exposure import exposure_tag, format_exposure, with_exposure
+    from benchmark.camera.exposure import check_exposure_override, exposure_tag, format_exposure, with_exposure
     from metricscenes.backends import check_scheduler, map_units, runs_in_process
     from metricscenes.lock import output_lock
     from metricscenes.store import Collection
@@ -215,6 +238,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     if isinstance(collection, (str, os.PathLike)):
         collection = Collection.open(collection)
     own = [c if hasattr(c, "sha256") else load_camera(c) for c in cameras]
+    for camera in own:  # a two-frame policy on an HDR pixel: refused before anything runs
+        check_exposure_override(camera, exposure)
     cameras = [with_exposure(c, exposure) for c in own]
     # A run folder is tagged only where the policy changed the camera: cam01-day always
     # holds the camera's own spec, and `--exposure auto_peak` reuses the reference runs.
@@ -268,9 +293,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
 
         in_process = runs_in_process(workers, scheduler)
 
-        def scene_progress(label: str):
-            # (a run computed here reports each scene; ``done`` is read when called: the runs before it)
-            return (lambda d, t: progress(done + d, total, label)) if progress and in_process else None
+        def scene_progress(label: str, n_cameras: int):
+            # (runs computed here report each scene; ``done`` is read when called: the runs before them)
+            return (lambda d, t: progress(done + d * n_cameras, total, label)) if progress and in_process else None
 
         def captures(camera, condition: str) -> Path | None:
             if captures_from is None:
@@ -278,15 +303,23 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             return captures_for(Path(captures_from) / run_dirs[camera.name, condition].relative_to(out_dir),
                                 camera, condition, collection, seed)
 
-        jobs = [(collection, camera, condition, detector, run_dirs[camera.name, condition], seed, save_images, backend,
-                 n_resamples, scene_progress(f"{camera.name} · {condition}"), captures(camera, condition))
-                for camera, condition in todo]
-        with closing(map_units(compute_run, jobs, workers=workers, scheduler=scheduler)) as finished:
-            for camera_name, condition, run_results in finished:  # in the order they finish
-                results[camera_name, condition] = run_results
-                done += n_scenes
+        # One unit per condition and group of cameras: each scene is read once per unit, and once
+        # per pixel grid resampled; as many groups as the backend runs units at once.
+        jobs = []
+        for condition in conditions:
+            pending = [camera for camera, c in todo if c == condition]
+            for group in camera_groups(pending, 1 if in_process else max(1, workers)):
+                label = f"{'+'.join(c.name for c in group)} · {condition}"
+                jobs.append((collection, group, condition, detector, [run_dirs[c.name, condition] for c in group], seed,
+                             save_images, backend, n_resamples, scene_progress(label, len(group)),
+                             [captures(c, condition) for c in group]))
+        with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
+            for finished_runs in finished:  # in the order they finish
+                for camera_name, condition, run_results in finished_runs:
+                    results[camera_name, condition] = run_results
+                done += n_scenes * len(finished_runs)
                 if progress:
-                    progress(done, total, f"{camera_name} · {condition}")
+                    progress(done, total, f"{'+'.join(name for name, _, _ in finished_runs)} · {finished_runs[0][1]}")
 
         rows, od50_rows, runs = [], [], []
         for camera in cameras:
