@@ -168,6 +168,22 @@ def day_paper_table(data: Path) -> str:
     return "\n".join(lines)
 
 
+def three_nights_table(data: Path) -> str:
+    """Per camera, the paper's night and the regulation night side by side: AP at 25 and 50 m
+    and OD50 in each, with the day OD50 for scale."""
+    table, od50 = _load(data, "")
+    od50 = od50.set_index(["camera", "condition"])
+    lines = [_row(["camera", "MTF50", "OD50 day (m)", "paper's night: AP 25 m / 50 m", "paper's night: OD50 (m)",
+                   "regulation night: AP 25 m / 50 m", "regulation night: OD50 (m)"]), _rule(7)]
+    for camera, part in table.groupby("camera"):
+        ap = part.set_index(["condition", "distance_m"])["ap"]
+        cells = [camera, f"{part['mtf50_cy_per_mm'].iloc[0]:.1f}", _od50_metres(od50.loc[(camera, "day")])]
+        for night in NIGHTS:
+            cells += [f"{ap[(night, 25.0)]:.2f} / {ap[(night, 50.0)]:.2f}", _od50_metres(od50.loc[(camera, night)])]
+        lines.append(_row(cells))
+    return "\n".join(lines)
+
+
 def night_factors_table(data: Path) -> str:
     """benchmarks/night_factors.py's rows: one change at a time at the paper's night's lux."""
     rows = pd.read_csv(data / "night-factors.csv")
@@ -183,6 +199,8 @@ def night_factors_table(data: Path) -> str:
 def markdown(data: Path) -> str:
     table, od50 = _load(data, "")
     parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])]
+    if set(NIGHTS) <= set(table["condition"]):
+        parts.append(f"### the nights side by side\n\n{three_nights_table(data)}")
     parts += [f"### input size (day)\n\n{input_size_table(data)}", f"### policies\n\n{policy_tables(data)}",
               f"### illuminance\n\n{illuminance_table(data)}"]
     if (data / "od50-day-paper.csv").exists():
