@@ -345,14 +345,16 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
 
     ``out_dirs``: one folder per camera; ``captures``: None, or one entry per camera (None or
     a run folder, as :func:`run_camera` takes it). ``progress`` ``(done, total)`` counts
-    scenes. The runs succeed or fail together: a failure leaves every folder as it was.
+    scenes. The runs succeed or fail together: a failure before the last scene is scored leaves
+    every folder as it was (one while the files move leaves the runs moved so far, each
+    results.json last).
     """
     from contextlib import ExitStack
 
     from benchmark.camera.pipeline import camera_window
     from metricscenes.lock import output_lock
 
-    cameras = list(cameras)
+    cameras, out_dirs = list(cameras), list(out_dirs)
     captures = [None] * len(cameras) if captures is None else list(captures)
     if not (len(out_dirs) == len(captures) == len(cameras)):
         raise ValueError("run_cameras needs one output folder (and one captures entry) per camera")

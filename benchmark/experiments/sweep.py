@@ -10,7 +10,8 @@ A collection subset (:class:`benchmark.experiments.run.CollectionSubset`, ``--en
 A run writes ``results.json`` last, so a sweep that was killed resumes with
 only its missing (or stale) runs. A condition's missing runs are done together, scene by
 scene (:func:`benchmark.experiments.run.run_cameras`: each scene read once, resampled once per
-pixel grid), in as many groups of cameras as the backend runs at once (:func:`camera_groups`);
+pixel grid), in as many groups of cameras as the backend runs at once (:func:`camera_groups`;
+on a running cluster, one group per pixel grid);
 a group killed midway is redone whole. The groups may go to worker processes or a dask cluster
 (``workers``, ``scheduler``: :mod:`metricscenes.backends`); each run writes only its own run
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
@@ -206,7 +207,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         seed: sensor-noise seed of every run and the bootstrap seed.
         n_resamples: bootstrap resamples of OD50 (over environments).
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
-            run advances by all its scenes at once (so does every run on a pool or cluster).
+            run advances by all its scenes at once (a group of runs on a pool or cluster, by
+            all of theirs).
         mtf_source: ``measured`` | ``analytic`` | ``published_group`` (see :func:`benchmark.measure.mtf.camera_mtf50`).
         exposure: an :class:`ExposureSpec` replacing every camera's exposure block (None:
             each camera's own); it changes the spec sha256 (the cache key) and tags the
@@ -229,7 +231,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.camera.pipeline import camera_window
     from benchmark.camera import load_camera
     from benchmark.camera.exposure import check_exposure_override, exposure_tag, format_exposure, with_exposure
-    from metricscenes.backends import check_scheduler, map_units, runs_in_process
+    from metricscenes.backends import check_scheduler, is_remote, map_units, runs_in_process
     from metricscenes.lock import output_lock
     from metricscenes.store import Collection
 
@@ -308,7 +310,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         jobs = []
         for condition in conditions:
             pending = [camera for camera, c in todo if c == condition]
-            for group in camera_groups(pending, 1 if in_process else max(1, workers)):
+            # (a running cluster's size is its own business: there, one group per pixel grid)
+            n_groups = 1 if in_process else len(pending) if is_remote(scheduler) else max(1, workers)
+            for group in camera_groups(pending, n_groups):
                 label = f"{'+'.join(c.name for c in group)} · {condition}"
                 jobs.append((collection, group, condition, detector, [run_dirs[c.name, condition] for c in group], seed,
                              save_images, backend, n_resamples, scene_progress(label, len(group)),
