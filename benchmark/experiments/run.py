@@ -429,13 +429,14 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
     order = sorted(range(len(runs)), key=lambda k: (str(grid_key(runs[k].camera)), k))
     scenes = collection.scenes()
     for i, scene in enumerate(scenes):
+        record = collection.condition_record(scene.scene_id, condition)  # a targeted condition's weights, once
         radiance, read_s = None, 0.0
         if any(run.captures is None for run in runs):
             t = time.perf_counter()
             radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
             read_s = time.perf_counter() - t
         for k in order:
-            runs[k].add(scene, radiance, read_s)
+            runs[k].add(scene, radiance, read_s, record)
         if progress:
             progress(i + 1, len(scenes))
     return [run.finish() for run in runs]
@@ -460,16 +461,16 @@ class _CameraRun:
         self.short_exposures: dict[str, float] = {}  # the hdr policy's second frame
         self.targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
 
-    def add(self, scene, radiance, read_s: float) -> None:
+    def add(self, scene, radiance, read_s: float, record: dict | None) -> None:
         """One scene: ``radiance`` its :class:`~metricscenes.radiance.SpectralScene` under the
-        condition (None where this run detects on captured images), read in ``read_s`` s."""
+        condition (None where this run detects on captured images), read in ``read_s`` s;
+        ``record``: what a targeted condition did in it (None for another condition)."""
         from PIL import Image
 
         from benchmark.camera.pipeline import simulate
         from benchmark.detectors import coco_category_id
 
         camera, captures, timings = self.camera, self.captures, self.timings
-        record = self.collection.condition_record(scene.scene_id, self.condition)
         if record is not None:
             self.targeted[scene.scene_id] = record
         if captures is None:
