@@ -230,6 +230,55 @@ def test_a_sweep_on_another_sweeps_captures_detects_the_same(serial_collection, 
         sweep(serial_collection, cameras, ["day"], at_640, tmp_path / "native", captures_from=tmp_path / "native")
 
 
+@pytest.mark.slow
+def test_a_multiscale_sweep_also_writes_the_sweeps_of_its_passes(serial_collection, tmp_path, monkeypatch):
+    """--also-input-size: a multiscale sweep also writes the native and 640 sweeps its two
+    passes make, file for file what sweeps at those input sizes write (``timing_s`` aside),
+    with one inference per pass and image; a run missing from one folder is made again; a size
+    that is not one of the detector's passes is refused before anything is written."""
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.detectors import load_detector
+    from benchmark.detectors.onnx_detector import OnnxDetector
+    from benchmark.experiments.sweep import sweep
+    from metricscenes.store import Collection
+
+    cameras = _small_cameras(tmp_path)
+    options = dict(n_resamples=20, mtf_source="analytic")
+    detectors = {size: load_detector("yolov5n-dynamic", input_size=size, model_dir=model_dir())
+                 for size in ("multiscale", "native", 640)}
+    for size, detector in detectors.items():
+        sweep(serial_collection, cameras, ["day"], detector, tmp_path / f"alone-{size}", **options)
+    passes = []
+    original = OnnxDetector._pass
+    monkeypatch.setattr(OnnxDetector, "_pass", lambda self, images, p, *a: passes.append(p) or original(self, images, p, *a))
+    also = {"native": tmp_path / "also-native", 640: tmp_path / "also-640"}
+    table = sweep(serial_collection, cameras, ["day"], detectors["multiscale"], tmp_path / "also-multiscale",
+                  also=also, **options)
+    assert len(passes) == 2 * len(cameras) * len(Collection.open(serial_collection).scenes())
+    for size in detectors:
+        assert _sweep_files(tmp_path / f"also-{size}") == _sweep_files(tmp_path / f"alone-{size}"), size
+    image = next((tmp_path / "also-640" / "runs" / "small-b-day" / "images").iterdir())  # linked, not copied
+    assert image.stat().st_ino == (tmp_path / "also-multiscale" / "runs" / "small-b-day" / "images" / image.name).stat().st_ino
+    assert len(table) == len(cameras) * 2  # (two distances)
+
+    shutil.rmtree(tmp_path / "also-640" / "runs" / "small-a-day")  # (a folder lost: its camera's runs made again)
+    sweep(serial_collection, cameras, ["day"], detectors["multiscale"], tmp_path / "also-multiscale", also=also, **options)
+    again, alone = _sweep_files(tmp_path / "also-640"), _sweep_files(tmp_path / "alone-640")
+    assert [r["reused"] for r in json.loads(again.pop("sweep.json"))["runs"]] == [False, True]
+    alone.pop("sweep.json")
+    assert again == alone
+
+    for size, detector, message in ((320, detectors["multiscale"], "input size 320 is not a pass"),
+                                    (640, detectors["native"], "its passes: one, its own")):
+        with pytest.raises(ValueError, match=message):
+            sweep(serial_collection, cameras, ["day"], detector, tmp_path / "refused", also={size: tmp_path / "x"},
+                  **options)
+    assert not (tmp_path / "refused").exists() and not (tmp_path / "x").exists()
+    with pytest.raises(ValueError, match="another of this sweep's folders"):
+        sweep(serial_collection, cameras, ["day"], detectors["multiscale"], tmp_path / "also-multiscale",
+              also={640: tmp_path / "also-multiscale"}, **options)
+
+
 # --- the backends themselves ---------------------------------------------------------------
 def test_map_units_gives_every_result_whatever_the_backend():
     units = [(2, n) for n in range(5)]

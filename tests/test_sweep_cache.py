@@ -154,6 +154,7 @@ def run_cameras_one_by_one(collection, cameras, condition, detector, out_dirs, *
     from benchmark.experiments import run as run_module
 
     captures = captures or [None] * len(cameras)
+    assert not kwargs.pop("also", None), "the fake runs write no pass policies' runs"
     progress = kwargs.pop("progress", None)  # scenes of the whole group: the last camera reports them
     return [run_module.run_camera(collection, camera, condition, detector, out_dir, captures=c,
                                   progress=progress if k == len(cameras) - 1 else None, **kwargs)

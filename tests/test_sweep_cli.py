@@ -42,6 +42,9 @@ def test_sweep_then_report(fakes):
     (["--cameras", "cam99"], "unknown camera 'cam99'"),
     (["--conditions", "dawn"], "unknown condition 'dawn'"),
     (["--mtf-source", "guess"], "--mtf-source must be one of"),
+    (["--also-input-size", "640"], "expected SIZE=FOLDER"),
+    (["--also-input-size", "big=elsewhere"], "input_size must be"),
+    (["--also-input-size", "640=a", "--also-input-size", "640=b"], "input size 640 given twice"),
 ])
 def test_sweep_errors_are_one_line(fakes, extra, message):
     args = ["sweep", "--collection", str(fakes), "--cameras", "cam01", "--out", str(fakes / "sw"), *extra]

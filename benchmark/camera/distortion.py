@@ -104,7 +104,7 @@ def resample_distorted(scene, cols: int, rows: int, sensor_extent: TanExtent, k1
     return out.transpose(1, 2, 0)
 
 
-@functools.lru_cache(maxsize=2)
+@functools.lru_cache(maxsize=8)  # a sweep's cameras, scene by scene (≤ 64 MB each at 2688 x 1512)
 def _sampling_map(sensor_extent: TanExtent, cols: int, rows: int, k1: float, k2: float):
     """Where :func:`resample_distorted` samples: the undistorted window the grid sees, the
     axial-pitch grid over it (cols_u, rows_u), and the continuous (row, col) index in that

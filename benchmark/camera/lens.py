@@ -119,7 +119,7 @@ def pupil_samples(coefficients: tuple[tuple[int, float], ...], reference_nm: flo
     return max(PUPIL_MIN_SAMPLES, 2 * math.ceil(PUPIL_SAMPLES_PER_SLOPE * slope / 2.0))
 
 
-@functools.lru_cache(maxsize=32)
+@functools.lru_cache(maxsize=128)  # 31 bands of a few cameras (a sweep goes scene by scene); ≤ 9 MB each
 def pupil_otf_table(coefficients: tuple[tuple[int, float], ...], reference_nm: float,
                     wavelength_nm: float) -> tuple[np.ndarray, int]:
     """(OTF table, pupil samples n) of an aberrated circular pupil at ``wavelength_nm``.

@@ -134,6 +134,23 @@ def run(
     console.print(f"wrote {out / 'results.json'}")
 
 
+def parse_also_input_sizes(values: list[str]) -> dict:
+    """``--also-input-size SIZE=FOLDER`` values as {input size: folder}; ValueError (one line)
+    for a value without '=', a size that is no input size, or a size given twice."""
+    from benchmark.detectors.policy import parse_input_size
+
+    out: dict = {}
+    for value in values:
+        size, sep, folder = value.partition("=")
+        if not sep or not size.strip() or not folder.strip():
+            raise ValueError(f"--also-input-size {value!r}: expected SIZE=FOLDER, e.g. 640=results/quick-640")
+        size = parse_input_size(size.strip())
+        if size in out:
+            raise ValueError(f"--also-input-size: input size {size} given twice")
+        out[size] = Path(folder.strip())
+    return out
+
+
 @app.command()
 def sweep(
     collection: Annotated[Path, typer.Option(help="collection folder written by `metricscenes generate`")],
@@ -157,6 +174,9 @@ def sweep(
     captures_from: Annotated[Optional[Path], typer.Option(
         help="another sweep folder on this collection: detect on its runs' camera images where they match "
              "(same camera, condition and seed) instead of simulating the camera again")] = None,
+    also_input_size: Annotated[Optional[list[str]], typer.Option(
+        help="SIZE=FOLDER (repeatable): also write the sweep of input size SIZE, one of the detector's passes "
+             "(native or 640 with multiscale), into FOLDER, from the same captures and inference")] = None,
     model_dir: Annotated[Optional[Path], typer.Option(help=MODEL_DIR_HELP)] = None,
 ) -> None:
     """Every camera × condition on a collection: AP table (sweep.csv), OD50 ± SD (od50.csv)."""
@@ -164,7 +184,7 @@ def sweep(
     from benchmark.camera import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.camera.exposure import format_exposure, parse_exposure
-    from benchmark.experiments.run import check_out_dir, subset_collection
+    from benchmark.experiments.run import check_out_dir, check_pass_policies, subset_collection
     from metricscenes.backends import BackendError, runs_in_process, threads_per_unit
     from metricscenes.outputs import SWEEP, check_output
     from metricscenes.store import Collection, CollectionError
@@ -184,6 +204,11 @@ def sweep(
         if not runs_in_process(workers, scheduler):  # each worker loads the detector again, with its share of the CPUs
             threads = threads_per_unit(threads, workers, scheduler)
         detector = load_detector(model, input_size=input_size, threads=threads, class_map=class_map, model_dir=model_dir)
+        also = parse_also_input_sizes(also_input_size or [])
+        check_pass_policies(detector, also)
+        for folder in also.values():
+            check_out_dir(folder)
+            check_output(folder, "--also-input-size", own=SWEEP)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
     if not cams or not conds:
@@ -197,7 +222,7 @@ def sweep(
 
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
                                progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy,
-                               workers=workers, scheduler=scheduler, captures_from=captures_from)
+                               workers=workers, scheduler=scheduler, captures_from=captures_from, also=also)
     except (ValueError, DetectorError, CollectionError, BackendError, OSError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     _, od50_table = sweep_module.load_sweep(out)

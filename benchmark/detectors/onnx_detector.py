@@ -171,6 +171,19 @@ class OnnxDetector:
                 results[i] = (placed[i][1].to_image(boxes[keep]), scores[keep], cls[keep])
         return results
 
+    def with_input_size(self, input_size: str | int) -> "OnnxDetector":
+        """The same model under another input-size policy, sharing this one's session."""
+        return OnnxDetector(self.session, path=self.path, name=self.name, family=self.family, sha256=self.sha256,
+                            input_size=input_size, class_map=self.class_map, threads=self.threads)
+
+    def pass_policies(self) -> list[str | int]:
+        """The single-pass policies whose passes this detector runs besides its own policy
+        ('native' and 640 for multiscale; none for a single pass): their detections come
+        with this detector's (:meth:`detect_policies`), with no inference of their own."""
+        if len(self.passes) < 2:
+            return []
+        return ["native" if p.size_px is None else p.size_px for p in self.passes]
+
     def detect(
         self,
         images: Sequence[np.ndarray],
@@ -185,25 +198,51 @@ class OnnxDetector:
         ``multi_label`` keeps every class above ``conf_threshold`` for a box (YOLOv5
         ``val.py``); the default keeps the best class only (``detect.py``).
         """
+        return self.detect_policies(images, conf_threshold=conf_threshold, iou_threshold=iou_threshold,
+                                    max_det=max_det, multi_label=multi_label)[self.input_size]
+
+    def detect_policies(
+        self,
+        images: Sequence[np.ndarray],
+        also: Sequence[str | int] = (),
+        *,
+        conf_threshold: float = 0.001,
+        iou_threshold: float = 0.45,
+        max_det: int = 300,
+        multi_label: bool = False,
+    ) -> dict[str | int, list[list[Detection]]]:
+        """:meth:`detect` under this detector's policy and under each policy of ``also``
+        (from :meth:`pass_policies`): {policy: detections per image}. A pass's own
+        detections are what that policy's detector finds (the same pass, unmerged), so a
+        multiscale run gives its native and 640 runs for nothing."""
         for k, im in enumerate(images):
             if not (isinstance(im, np.ndarray) and im.ndim == 3 and im.shape[2] == 3 and im.dtype == np.uint8):
                 raise ValueError(f"images[{k}] must be an RGB uint8 array (H, W, 3), got {getattr(im, 'dtype', type(im))} {getattr(im, 'shape', '')}")
+        labels = self.pass_policies()
+        for policy in also:
+            if parse_input_size(policy) not in labels:
+                raise ValueError(f"input size {policy} is not one of this detector's passes "
+                                 f"({', '.join(map(str, labels)) or 'it runs one'})")
         per_pass = [self._pass(images, p, conf_threshold, iou_threshold, max_det, multi_label) for p in self.passes]
-        out: list[list[Detection]] = []
-        for i in range(len(images)):
-            boxes = np.concatenate([r[i][0] for r in per_pass])
-            scores = np.concatenate([r[i][1] for r in per_pass])
-            cls = np.concatenate([r[i][2] for r in per_pass])
-            if len(per_pass) > 1:  # multiscale: merge the passes by class-wise NMS
-                keep = batched_nms(boxes, scores, cls, iou_threshold, max_det)
-                boxes, scores, cls = boxes[keep], scores[keep], cls[keep]
-            out.append(
-                [
-                    Detection(int(c), COCO80_NAMES[int(c)], float(s), tuple(float(v) for v in b))
-                    for b, s, c in zip(boxes, scores, cls)
-                ]
-            )
+        out = {self.input_size: [self._merged([r[i] for r in per_pass], iou_threshold, max_det)
+                                 for i in range(len(images))]}
+        for policy in also:
+            found = per_pass[labels.index(parse_input_size(policy))]
+            out[parse_input_size(policy)] = [self._merged([found[i]], iou_threshold, max_det) for i in range(len(images))]
         return out
+
+    @staticmethod
+    def _merged(passes: list, iou_threshold: float, max_det: int) -> list[Detection]:
+        """One image's detections from its (boxes, scores, classes) per pass: several passes
+        merged by class-wise NMS (multiscale), one taken as it is."""
+        boxes = np.concatenate([r[0] for r in passes])
+        scores = np.concatenate([r[1] for r in passes])
+        cls = np.concatenate([r[2] for r in passes])
+        if len(passes) > 1:  # multiscale: merge the passes by class-wise NMS
+            keep = batched_nms(boxes, scores, cls, iou_threshold, max_det)
+            boxes, scores, cls = boxes[keep], scores[keep], cls[keep]
+        return [Detection(int(c), COCO80_NAMES[int(c)], float(s), tuple(float(v) for v in b))
+                for b, s, c in zip(boxes, scores, cls)]
 
 
 @lru_cache(maxsize=4)

@@ -16,7 +16,9 @@ The camera's images depend on the camera, condition, collection and seed only
 (:func:`capture_key`), not on the detector: a run given ``captures`` (an earlier run folder
 of the same capture key, with its images) detects on those images and skips the radiance and
 the camera, with the same detections as a run that simulates them (another detector, input
-size or class map on the same captures: ``benchmark sweep --captures-from``).
+size or class map on the same captures: ``benchmark sweep --captures-from``). A multiscale
+run also writes, where asked (``also``), the runs of the single-pass policies its passes
+make (native, 640): the same files those policies' runs write, from one inference.
 
 A run on a :class:`CollectionSubset` (``--environments 0-2,5 --distances 25,50``, a quick
 try) records ``subset`` in results.json; `benchmark submit` refuses it and a sweep never
@@ -36,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmark.detectors.policy import parse_input_size
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
     RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
@@ -336,7 +339,7 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
 
 def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed: int = 0,
                 save_images: bool = True, backend: str = "faster-coco-eval", progress=None,
-                captures=None) -> list[RunResults]:
+                captures=None, also: dict | None = None) -> list[RunResults]:
     """:func:`run_camera` for several cameras at once, scene by scene: each scene's radiance
     is read once for all of them, and resampled once per pixel grid (the cameras are taken
     grid by grid; :meth:`metricscenes.radiance.SpectralScene.resample` keeps the last).
@@ -344,8 +347,11 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
     (``results.json``'s ``timing_s`` aside, where ``read_radiance`` is the shared read).
 
     ``out_dirs``: one folder per camera; ``captures``: None, or one entry per camera (None or
-    a run folder, as :func:`run_camera` takes it). ``progress`` ``(done, total)`` counts
-    scenes. The runs succeed or fail together: a failure before the last scene is scored leaves
+    a run folder, as :func:`run_camera` takes it). ``also``: {input size: one folder per
+    camera} for policies among ``detector.pass_policies()`` (a multiscale detector's native
+    and 640 passes): each gets the run a detector of that input size would write there
+    (images linked, not copied), from the same inference. ``progress`` ``(done, total)`` counts
+    scenes. Returns the runs in ``out_dirs`` (the others are on disk). The runs succeed or fail together: a failure before the last scene is scored leaves
     every folder as it was (one while the files move leaves the runs moved so far, each
     results.json last).
     """
@@ -356,30 +362,35 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
 
     cameras, out_dirs = list(cameras), list(out_dirs)
     captures = [None] * len(cameras) if captures is None else list(captures)
-    if not (len(out_dirs) == len(captures) == len(cameras)):
+    also = {parse_input_size(size): list(dirs) for size, dirs in (also or {}).items()}
+    if not (len(out_dirs) == len(captures) == len(cameras)) or any(len(d) != len(cameras) for d in also.values()):
         raise ValueError("run_cameras needs one output folder (and one captures entry) per camera")
-    out_dirs = [check_out_dir(d) for d in out_dirs]  # before anything is written
-    if len({d.resolve() for d in out_dirs}) != len(out_dirs):
+    check_pass_policies(detector, also)
+    policies = [detector] + [detector.with_input_size(size) for size in also]
+    folders = [[check_out_dir(d) for d in dirs] for dirs in [out_dirs, *also.values()]]  # before anything is written
+    every = [d for dirs in folders for d in dirs]
+    if len({d.resolve() for d in every}) != len(every):
         raise ValueError("run_cameras needs a distinct output folder per camera")
     field = collection_field(collection)
     windows = [camera_window(camera, field) for camera in cameras]  # a camera wider than the collection: refused here
     captured = [None if c is None else (Path(c), read_captures(c, camera, condition, collection, seed))
                 for camera, c in zip(cameras, captures)]
-    created = [[p for p in (d, *d.parents) if not p.exists()] for d in out_dirs]
+    created = [[p for p in (d, *d.parents) if not p.exists()] for d in every]
     try:
         with ExitStack() as held:
-            for d in out_dirs:
+            for d in every:
                 d.mkdir(parents=True, exist_ok=True)
                 held.enter_context(output_lock(d, "benchmark run", "run folder"))
                 remove_stale_stages(d)
-            stages = [Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=d)) for d in out_dirs]
-            held.callback(lambda: [shutil.rmtree(stage, ignore_errors=True) for stage in stages])
-            runs = [_CameraRun(collection, camera, condition, detector, stage, field, window, seed=seed,
-                               save_images=save_images, backend=backend, captures=c)
-                    for camera, stage, window, c in zip(cameras, stages, windows, captured)]
+            stages = [[Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=d)) for d in dirs] for dirs in folders]
+            held.callback(lambda: [shutil.rmtree(stage, ignore_errors=True) for row in stages for stage in row])
+            runs = [_CameraRun(collection, camera, condition, policies, [row[k] for row in stages], field, window,
+                               seed=seed, save_images=save_images, backend=backend, captures=c)
+                    for k, (camera, window, c) in enumerate(zip(cameras, windows, captured))]
             results = _run_scenes(collection, condition, runs, progress)
-            for d, stage in zip(out_dirs, stages):
-                _move_into_place(stage, d, save_images)
+            for dirs, row in zip(folders, stages):
+                for d, stage in zip(dirs, row):
+                    _move_into_place(stage, d, save_images)
             return results
     except BaseException:
         for folders in created:  # the folders these runs made, innermost first, if still empty
@@ -389,6 +400,16 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
                 except OSError:
                     break
         raise
+
+
+def check_pass_policies(detector, sizes) -> None:
+    """ValueError (one line) unless every input size of ``sizes`` is one of the single-pass
+    policies whose passes ``detector`` runs (``pass_policies``: native and 640 for multiscale)."""
+    passes = detector.pass_policies() if sizes else []
+    for size in sizes:
+        if parse_input_size(size) not in passes:
+            raise ValueError(f"input size {size} is not a pass of {detector.name} at input size {detector.input_size}"
+                             f" (its passes: {', '.join(map(str, passes)) or 'one, its own'})")
 
 
 STAGE_PREFIX = ".partial-"
@@ -443,20 +464,23 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
 
 
 class _CameraRun:
-    """One camera's run in its staging folder: :meth:`add` takes the scenes one by one
-    (simulate or read the captured image, detect, save), :meth:`finish` scores them and
-    writes detections, ground truth and results.json there. ``window`` is the part of the
-    collection's ``field`` the camera samples (and its ground truth follows); ``captures``:
-    (folder, results) of the run whose images stand for the camera's."""
+    """One camera's run in its staging folders, one per input-size policy (``detectors[0]``
+    the detector's own, then those of its passes: ``stages`` alike): :meth:`add` takes the
+    scenes one by one (simulate or read the captured image, detect, save), :meth:`finish`
+    scores them and writes detections, ground truth and results.json in each stage.
+    ``window`` is the part of the collection's ``field`` the camera samples (and its ground
+    truth follows); ``captures``: (folder, results) of the run whose images stand for the
+    camera's."""
 
-    def __init__(self, collection, camera, condition: str, detector, stage: Path, field, window, *, seed: int,
-                 save_images: bool, backend: str, captures: tuple[Path, RunResults] | None):
-        self.collection, self.camera, self.condition, self.detector = collection, camera, condition, detector
-        self.stage, self.field, self.window = stage, field, window
+    def __init__(self, collection, camera, condition: str, detectors: list, stages: list[Path], field, window, *,
+                 seed: int, save_images: bool, backend: str, captures: tuple[Path, RunResults] | None):
+        self.collection, self.camera, self.condition, self.detectors = collection, camera, condition, detectors
+        self.stages, self.field, self.window = stages, field, window
         self.seed, self.save_images, self.backend, self.captures = seed, save_images, backend, captures
-        (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
+        for stage in stages:
+            (stage / "images" if save_images else stage).mkdir(parents=True, exist_ok=True)
         self.timings = Timings()
-        self.detections: list[dict] = []
+        self.detections: list[list[dict]] = [[] for _ in detectors]
         self.exposures: dict[str, float] = {}
         self.short_exposures: dict[str, float] = {}  # the hdr policy's second frame
         self.targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
@@ -490,39 +514,55 @@ class _CameraRun:
             timings.add("read_captures", t)
         t = time.perf_counter()
         # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
-        (found,) = self.detector.detect([rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
+        detector, also = self.detectors[0], [d.input_size for d in self.detectors[1:]]
+        if also:  # the passes' own policies from the same inference
+            by_policy = detector.detect_policies([rgb8], also, conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
+            found_by = [by_policy[d.input_size][0] for d in self.detectors]
+        else:
+            found_by = detector.detect([rgb8], conf_threshold=AP_SCORE_THRESHOLD, multi_label=True)
         timings.add("detect", t)
-        for d in found:
-            x1, y1, x2, y2 = (float(v) for v in d.box_xyxy)
-            self.detections.append({
-                "image_id": scene.image_id, "category_id": coco_category_id(d.class_id),
-                "bbox": [round(x1, 3), round(y1, 3), round(x2 - x1, 3), round(y2 - y1, 3)],
-                "score": round(float(d.score), 6),
-            })
+        for detections, found in zip(self.detections, found_by):
+            for d in found:
+                x1, y1, x2, y2 = (float(v) for v in d.box_xyxy)
+                detections.append({
+                    "image_id": scene.image_id, "category_id": coco_category_id(d.class_id),
+                    "bbox": [round(x1, 3), round(y1, 3), round(x2 - x1, 3), round(y2 - y1, 3)],
+                    "score": round(float(d.score), 6),
+                })
         if self.save_images:
             t = time.perf_counter()
-            image = self.stage / "images" / f"{scene.scene_id}.png"
+            name = f"{scene.scene_id}.png"
+            source = self.stages[0] / "images" / name
             if captures is None:
-                Image.fromarray(rgb8).save(image, compress_level=1)
+                Image.fromarray(rgb8).save(source, compress_level=1)
             else:
-                shutil.copyfile(captures[0] / "images" / f"{scene.scene_id}.png", image)
+                link_or_copy(captures[0] / "images" / name, source)
+            for stage in self.stages[1:]:
+                link_or_copy(source, stage / "images" / name)
             timings.add("save_images", t)
 
     def finish(self) -> RunResults:
+        """Score and write every policy's stage; the detector's own run's results."""
         from benchmark.camera.pipeline import lens_mapping
-        from benchmark.scoring import ap_by_distance, od50
-        from metricscenes import __version__
         from metricscenes.store import scale_groundtruth
 
-        collection, camera, detector, stage, timings = self.collection, self.camera, self.detector, self.stage, self.timings
-        geometry = _geometry_record(camera, self.field, self.window)
+        camera = self.camera
         sensor_window, to_sensor = lens_mapping(camera, self.field)
-        groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
+        groundtruth = scale_groundtruth(self.collection.groundtruth(), camera.width_px, camera.height_px,
                                         field=self.field, window=sensor_window, to_sensor=to_sensor)
+        return [self._write(groundtruth, detector, stage, detections)
+                for detector, stage, detections in zip(self.detectors, self.stages, self.detections)][0]
+
+    def _write(self, groundtruth: dict, detector, stage: Path, detections: list[dict]) -> RunResults:
+        from benchmark.scoring import ap_by_distance, od50
+        from metricscenes import __version__
+
+        collection, camera, timings = self.collection, self.camera, self.timings
+        geometry = _geometry_record(camera, self.field, self.window)
         t = time.perf_counter()
-        per_distance = ap_by_distance(groundtruth, self.detections, backend=self.backend)
+        per_distance = ap_by_distance(groundtruth, detections, backend=self.backend)
         timings.add("score", t)
-        detections_bytes = json.dumps(self.detections, separators=(",", ":")).encode()
+        detections_bytes = json.dumps(detections, separators=(",", ":")).encode()
         per_distance = [DistanceAP(**row) for row in per_distance]
         detector_record = DetectorRecord(name=detector.name, family=detector.family, sha256=detector.sha256,
                                          input_size=detector.input_size, score_threshold=AP_SCORE_THRESHOLD,
@@ -568,6 +608,16 @@ class _CameraRun:
         (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
         write_results(stage / "results.json", results)
         return results
+
+
+def link_or_copy(source: Path, target: Path) -> None:
+    """``target`` as a hard link to ``source`` (a camera image is written once and never
+    changed, so runs that share it need not hold a copy each), or a copy where the file
+    system cannot link."""
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copyfile(source, target)
 
 
 def camera_record(camera) -> CameraRecord:

@@ -37,7 +37,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from contextlib import closing
+from contextlib import ExitStack, closing
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterable
 
@@ -158,17 +158,20 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
 
 def compute_runs(collection, cameras: list, condition: str, detector, run_dirs: list[Path], seed: int,
                  save_images: bool, backend: str, n_resamples: int, progress=None,
-                 captures: list[Path | None] | None = None) -> list[tuple[str, str, RunResults]]:
+                 captures: list[Path | None] | None = None,
+                 also: dict | None = None) -> list[tuple[str, str, RunResults]]:
     """Several cameras' runs under one condition (:func:`benchmark.experiments.run.run_cameras`:
     each scene read once for all of them) and their bootstrap OD50s, in whichever process the
     sweep's backend gives them: everything they write is in ``run_dirs`` (``od50.json`` too),
-    which no other unit touches (``captures``, another sweep's run folders, are only read).
+    which no other unit touches (``captures``, another sweep's run folders, are only read),
+    and in ``also`` ({input size: run folders}: the runs of the detector's passes).
     Returns (camera name, condition, results) per camera."""
     from benchmark.experiments import run as run_module
 
     results = run_module.run_cameras(collection, cameras, condition, detector, run_dirs, seed=seed,
-                                     save_images=save_images, backend=backend, progress=progress, captures=captures)
-    for run_dir in run_dirs:
+                                     save_images=save_images, backend=backend, progress=progress, captures=captures,
+                                     also=also)
+    for run_dir in [*run_dirs, *(d for dirs in (also or {}).values() for d in dirs)]:
         run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
     return [(camera.name, condition, r) for camera, r in zip(cameras, results)]
 
@@ -195,7 +198,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
           n_resamples: int = BOOTSTRAP_RESAMPLES, progress: Progress | None = None, mtf_source: str = "measured",
           backend: str = "faster-coco-eval", save_images: bool = True,
           exposure: ExposureSpec | None = None, workers: int = 1, scheduler: str | None = None,
-          captures_from: str | os.PathLike | None = None) -> pd.DataFrame:
+          captures_from: str | os.PathLike | None = None, also: dict | None = None) -> pd.DataFrame:
     """Run every camera × condition (reusing cached runs); write and return the AP table.
 
     Args:
@@ -223,6 +226,11 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             collection and seed; :func:`captures_for`) detects on them instead of simulating
             the camera again. Same detections either way; ``results.json`` records
             ``captures_from``.
+        also: {input size: sweep folder} for the single-pass policies whose passes the
+            detector runs (``detector.pass_policies()``: native and 640 for multiscale):
+            each folder gets the sweep a detector of that input size would write (runs,
+            tables, sweep.json; ``timing_s`` aside), from the same captures and inference.
+            A run is computed where it is missing from any of the folders.
 
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
@@ -230,7 +238,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     from benchmark.experiments import run as run_module
     from benchmark.camera.pipeline import camera_window
     from benchmark.camera import load_camera
-    from benchmark.camera.exposure import check_exposure_override, exposure_tag, format_exposure, with_exposure
+    from benchmark.camera.exposure import check_exposure_override, exposure_tag, with_exposure
+    from benchmark.detectors.policy import parse_input_size
     from metricscenes.backends import check_scheduler, is_remote, map_units, runs_in_process
     from metricscenes.lock import output_lock
     from metricscenes.store import Collection
@@ -271,27 +280,41 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     out_dir = run_module.check_out_dir(out_dir)
     if captures_from is not None and Path(captures_from).resolve() == out_dir.resolve():
         raise ValueError(f"--captures-from {captures_from} is the sweep folder itself: name another sweep's folder")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with output_lock(out_dir, "benchmark sweep", "sweep folder"):  # one sweep writes a folder at a time
-        (out_dir / "runs").mkdir(parents=True, exist_ok=True)
+    also = {parse_input_size(size): run_module.check_out_dir(folder) for size, folder in (also or {}).items()}
+    run_module.check_pass_policies(detector, also)
+    for size, folder in also.items():
+        others = [out_dir, *(Path(captures_from) for _ in [1] if captures_from is not None),
+                  *(f for s, f in also.items() if s != size)]
+        if any(folder.resolve() == other.resolve() for other in others):
+            raise ValueError(f"the sweep folder for input size {size}, {folder}, is another of this sweep's folders")
+    detectors = {None: detector, **{size: detector.with_input_size(size) for size in also}}
+    folders = {None: out_dir, **also}
+    with ExitStack() as held:
+        for folder in folders.values():
+            folder.mkdir(parents=True, exist_ok=True)
+            held.enter_context(output_lock(folder, "benchmark sweep", "sweep folder"))  # one sweep writes a folder at a time
+            (folder / "runs").mkdir(parents=True, exist_ok=True)
 
         n_scenes = len(collection.scenes())
         total, done = n_scenes * len(cameras) * len(conditions), 0
-        run_dirs = {(camera.name, condition): out_dir / "runs" / (run_name(camera.name, condition, tags[camera.name]) + suffix)
-                    for camera in cameras for condition in conditions}
-        results: dict[tuple[str, str], RunResults] = {}
+        run_names = {(camera.name, condition): run_name(camera.name, condition, tags[camera.name]) + suffix
+                 for camera in cameras for condition in conditions}
+        run_dirs = {(size, *k): folders[size] / "runs" / name for size in folders for k, name in run_names.items()}
+        results: dict[tuple, RunResults] = {}
         todo = []
         for camera in cameras:
             for condition in conditions:
-                cached = cached_results(run_dirs[camera.name, condition], run_key(camera, condition, detector, collection, seed))
-                if cached is None:
+                cached = {size: cached_results(run_dirs[size, camera.name, condition],
+                                               run_key(camera, condition, d, collection, seed))
+                          for size, d in detectors.items()}
+                if any(r is None for r in cached.values()):  # (a missing policy's run: all of them again)
                     todo.append((camera, condition))
                     continue
-                results[camera.name, condition] = cached
+                results.update({(size, camera.name, condition): r for size, r in cached.items()})
                 done += n_scenes
                 if progress:
                     progress(done, total, f"{camera.name} · {condition}")
-        reused = set(results)
+        reused = {(camera_name, condition) for size, camera_name, condition in results}
 
         in_process = runs_in_process(workers, scheduler)
 
@@ -302,7 +325,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         def captures(camera, condition: str) -> Path | None:
             if captures_from is None:
                 return None
-            return captures_for(Path(captures_from) / run_dirs[camera.name, condition].relative_to(out_dir),
+            return captures_for(Path(captures_from) / "runs" / run_names[camera.name, condition],
                                 camera, condition, collection, seed)
 
         # One unit per condition and group of cameras: each scene is read once per unit, and once
@@ -314,55 +337,75 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
             n_groups = 1 if in_process else len(pending) if is_remote(scheduler) else max(1, workers)
             for group in camera_groups(pending, n_groups):
                 label = f"{'+'.join(c.name for c in group)} · {condition}"
-                jobs.append((collection, group, condition, detector, [run_dirs[c.name, condition] for c in group], seed,
-                             save_images, backend, n_resamples, scene_progress(label, len(group)),
-                             [captures(c, condition) for c in group]))
+                jobs.append((collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
+                             seed, save_images, backend, n_resamples, scene_progress(label, len(group)),
+                             [captures(c, condition) for c in group],
+                             {size: [run_dirs[size, c.name, condition] for c in group] for size in also}))
         with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
             for finished_runs in finished:  # in the order they finish
                 for camera_name, condition, run_results in finished_runs:
-                    results[camera_name, condition] = run_results
+                    results[None, camera_name, condition] = run_results
+                    for size in also:  # (written by the unit, read back here)
+                        results[size, camera_name, condition] = read_results(run_dirs[size, camera_name, condition]
+                                                                             / "results.json")
                 done += n_scenes * len(finished_runs)
                 if progress:
                     progress(done, total, f"{'+'.join(name for name, _, _ in finished_runs)} · {finished_runs[0][1]}")
 
-        rows, od50_rows, runs = [], [], []
-        for camera in cameras:
-            mtf50, source = camera_mtf50(camera, mtf_source)
-            ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
-                     "mtf50_cy_per_mm": mtf50, "mtf50_source": source,  # mtf50 None: NaN in the tables
-                     "focal_length_mm": camera.optics.focal_length_mm, "mtf50_cy_per_mrad": camera.cy_per_mrad(mtf50)}
-            for condition in conditions:
-                run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
-                runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
-                                     reused=(camera.name, condition) in reused))
-                for r in run_results.per_distance:
-                    rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
-                                         n_images=r.n_images))
-                boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
-                lo, hi = boot.ci95_m
-                od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
-                                         ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
-                                         n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
+        tables = {size: _write_sweep(folders[size], collection, cameras, conditions, detectors[size],
+                                     {k[1:]: r for k, r in results.items() if k[0] == size},
+                                     {k[1:]: d for k, d in run_dirs.items() if k[0] == size}, reused,
+                                     seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, backend=backend,
+                                     subset=subset, exposure=exposure)
+                  for size in folders}
+        return tables[None]
 
-        table = write_sweep_table(out_dir / "sweep.csv", rows)
-        od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
-        record = SweepRecord(
-            format=SWEEP_FORMAT,
-            collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
-                                        path=str(collection.root)),
-            detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
-            seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
-            cameras=names, conditions=conditions, runs=runs,
-            # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
-            table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
-        )
-        if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
-            record.subset = Subset(**subset)
-        if exposure is not None:  # only then, so that other sweeps keep their bytes
-            record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
-                                            spec=exposure.model_dump(mode="json"))
-        write_sweep_record(out_dir / "sweep.json", record)
-        return table
+
+def _write_sweep(out_dir: Path, collection, cameras: list, conditions: list[str], detector, results: dict,
+                 run_dirs: dict, reused: set, *, seed: int, n_resamples: int, mtf_source: str, backend: str,
+                 subset, exposure) -> pd.DataFrame:
+    """A sweep folder's tables (sweep.csv, od50.csv) and sweep.json from its runs' results and
+    folders ({(camera, condition): ...}); returns the AP table."""
+    from benchmark.camera.exposure import exposure_tag, format_exposure
+
+    rows, od50_rows, runs = [], [], []
+    for camera in cameras:
+        mtf50, source = camera_mtf50(camera, mtf_source)
+        ident = {"camera": camera.name, "pixel_um": camera.pixel_um, "f_number": camera.f_number,
+                 "mtf50_cy_per_mm": mtf50, "mtf50_source": source,  # mtf50 None: NaN in the tables
+                 "focal_length_mm": camera.optics.focal_length_mm, "mtf50_cy_per_mrad": camera.cy_per_mrad(mtf50)}
+        for condition in conditions:
+            run_dir, run_results = run_dirs[camera.name, condition], results[camera.name, condition]
+            runs.append(SweepRun(camera=camera.name, condition=condition, path=str(run_dir.relative_to(out_dir)),
+                                 reused=(camera.name, condition) in reused))
+            for r in run_results.per_distance:
+                rows.append(SweepRow(**ident, condition=condition, distance_m=r.distance_m, ap=r.ap, ap50=r.ap50,
+                                     n_images=r.n_images))
+            boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
+            lo, hi = boot.ci95_m
+            od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
+                                     ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
+                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
+
+    table = write_sweep_table(out_dir / "sweep.csv", rows)
+    od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
+    record = SweepRecord(
+        format=SWEEP_FORMAT,
+        collection=CollectionRecord(name=collection.name, manifest_sha256=collection.manifest_sha256,
+                                    path=str(collection.root)),
+        detector=DetectorRecord(name=detector.name, sha256=detector.sha256, input_size=str(detector.input_size)),
+        seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, scoring_backend=backend,
+        cameras=[c.name for c in cameras], conditions=conditions, runs=runs,
+        # the rows as the tables hold them (pandas' dtypes), as sweep.json has always written them
+        table=table.to_dict(orient="records"), od50=od50_table.to_dict(orient="records"),
+    )
+    if subset:  # a quick try on part of the collection (other sweeps keep their bytes)
+        record.subset = Subset(**subset)
+    if exposure is not None:  # only then, so that other sweeps keep their bytes
+        record.exposure = SweepExposure(policy=format_exposure(exposure), tag=exposure_tag(exposure),
+                                        spec=exposure.model_dump(mode="json"))
+    write_sweep_record(out_dir / "sweep.json", record)
+    return table
 
 
 def illuminance_table(table: pd.DataFrame) -> pd.DataFrame:
