@@ -85,3 +85,19 @@ def test_the_flare_camera_keeps_a_uniform_fields_light():
     assert np.all(mean < 1) and np.all(mean > 1 - 0.05 * g)
     # a corner keeps its direct light, 1 − g, and about a quadrant of its glare
     assert 1 - 0.8 * g < ratio.min() < 1 - 0.6 * g
+
+
+def test_the_hdr_variant_is_the_imx490_like_sensor_on_cam12s_grid_and_field():
+    """cam12-hdr: auto-imx490-like's sensor, exposure and ISP read out in cam12's 1920 x 1080,
+    behind cam12's f-number and field of view (the lens scaled to the 3.0 um pixel): the same
+    angular sampling as cam12, so the comparison is the sensor's."""
+    cam12, hdr, imx490 = load_camera("cam12"), load_camera(CAMERAS / "cam12-hdr.yaml"), load_camera("auto-imx490-like")
+    assert (hdr.width_px, hdr.height_px) == (cam12.width_px, cam12.height_px)
+    assert hdr.f_number == cam12.f_number
+    assert hdr.hfov_deg == pytest.approx(cam12.hfov_deg, rel=1e-4) and hdr.hfov_deg <= cam12.hfov_deg
+    assert hdr.vfov_deg == pytest.approx(cam12.vfov_deg, rel=1e-4) and hdr.vfov_deg <= cam12.vfov_deg
+    window = {"active_width_mm", "active_height_mm", "width_px", "height_px"}  # (the last two derived)
+    ours, theirs = hdr.sensor.model_dump(), imx490.sensor.model_dump()
+    assert {k for k in ours if ours[k] != theirs[k]} == window
+    assert (hdr.exposure, hdr.isp) == (imx490.exposure, imx490.isp)
+    assert hdr.sensor.dcg is not None and hdr.name == "cam12-hdr"
