@@ -350,10 +350,10 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
     a run folder, as :func:`run_camera` takes it). ``also``: {input size: one folder per
     camera} for policies among ``detector.pass_policies()`` (a multiscale detector's native
     and 640 passes): each gets the run a detector of that input size would write there
-    (images linked, not copied), from the same inference. ``progress`` ``(done, total)`` counts
-    scenes. Returns the runs in ``out_dirs`` (the others are on disk). The runs succeed or fail together: a failure before the last scene is scored leaves
-    every folder as it was (one while the files move leaves the runs moved so far, each
-    results.json last).
+    (images linked, not copied), from the same inference. ``progress`` ``(done, total)``
+    counts scenes. Returns the runs in ``out_dirs`` (the others are on disk). The runs succeed
+    or fail together: a failure before the last scene is scored leaves every folder as it was
+    (one while the files move leaves the runs moved so far, each results.json last).
     """
     from contextlib import ExitStack
 
@@ -393,8 +393,8 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
                     _move_into_place(stage, d, save_images)
             return results
     except BaseException:
-        for folders in created:  # the folders these runs made, innermost first, if still empty
-            for folder in folders:
+        for made in created:  # the folders these runs made, innermost first, if still empty
+            for folder in made:
                 try:
                     folder.rmdir()
                 except OSError:
