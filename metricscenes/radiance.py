@@ -75,6 +75,14 @@ class SpectralScene:
     # The last grid this scene was resampled onto and the result: cameras that share a pixel
     # grid (the paper's 13 have six) read one composite, not one each.
     _last_resample: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    # What every grid's resample reads band by band (the plate, each inset as pasted, its cells
+    # at the plate's resolution), made once per scene rather than once per grid.
+    _grid_free: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def _once(self, key: tuple, make):
+        if key not in self._grid_free:
+            self._grid_free[key] = make()
+        return self._grid_free[key]
 
     @property
     def extent(self) -> TanExtent:
@@ -109,13 +117,13 @@ class SpectralScene:
         if key in self._last_resample:
             return self._last_resample[key]
         plate = self.layers[0]
-        out = _apply(*_weights(plate, cols, rows, extent), plate.radiance)
+        out = _apply(*_weights(plate, cols, rows, extent), self._once(("plate",), lambda: _band_major(plate.radiance)))
         finer = (extent.width / cols < plate.pixel_tan[0] * (1 - 1e-9)
                  and extent.height / rows < plate.pixel_tan[1] * (1 - 1e-9))
         for inset in self.layers[1:]:
-            _paste(out, inset, cols, rows, extent, self.extent)
+            _paste(out, inset, cols, rows, extent, self.extent, once=self._once)
             if inset.sharp is not None and finer:
-                _match_plate(out, inset, plate, cols, rows, extent)
+                _match_plate(out, inset, plate, cols, rows, extent, once=self._once)
         out.flags.writeable = False
         self._last_resample.clear()  # one grid kept: a sweep takes its cameras grid by grid
         self._last_resample[key] = out.transpose(1, 2, 0)
@@ -187,15 +195,21 @@ def feather_weights(inset: RadianceLayer, within: TanExtent) -> tuple[np.ndarray
             ramp(cols, e.x0 > within.x0 + tol, e.x1 < within.x1 - tol))
 
 
+def _made_now(key: tuple, make):
+    """A ``once`` that keeps nothing (:meth:`SpectralScene._once` keeps for the scene)."""
+    return make()
+
+
 def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: TanExtent,
-           within: TanExtent, *, weighted: bool = True) -> None:
+           within: TanExtent, *, weighted: bool = True, once=_made_now) -> None:
     """Paste ``inset`` over band planes ``out`` (bands, rows, cols) in place: where the
     inset covers a target pixel its radiance replaces the plate's, blended by the area
     it covers times its feather weight (:func:`feather_weights`; ``within`` is the
     plate's extent). Only the window the inset touches is computed. ``weighted``: a
     target pixel takes the feather-weighted mean of the inset pixels it overlaps (the
     inset's detail, as it was pasted); else their plain mean, blended by their mean weight
-    (a pixel holds no detail finer than itself: :func:`_match_plate`'s cells)."""
+    (a pixel holds no detail finer than itself: :func:`_match_plate`'s cells). ``once(key,
+    make)`` gives what does not depend on the target grid (the inset band by band)."""
     overlap_x = _overlap_matrix(inset.extent.x0, inset.extent.x1, inset.radiance.shape[1], extent.x0, extent.x1, cols)
     overlap_y = _overlap_matrix(inset.extent.y0, inset.extent.y1, inset.radiance.shape[0], extent.y0, extent.y1, rows)
     cover_x, cover_y = (np.asarray(m.sum(axis=1)).ravel() for m in (overlap_x, overlap_y))
@@ -210,15 +224,15 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
             # Resampled weighted radiance over resampled weight: the feathered mean of the
             # inset pixels a target pixel overlaps; it counts for their area times weight.
             mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
-            values = _apply(wy[y_win], wx[x_win],
-                            inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None])
+            values = _apply(wy[y_win], wx[x_win], once(("feathered", id(inset)), lambda: _band_major(
+                inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None])))
             values *= np.divide(1.0, mean_weight, out=np.zeros_like(mean_weight),
                                 where=mean_weight > 0).astype(np.float32)
         else:
-            values = _apply(wy[y_win], wx[x_win], inset.radiance)
+            values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: _band_major(inset.radiance)))
         cover_x, cover_y = overlap_x @ feather_x, overlap_y @ feather_y
     else:
-        values = _apply(wy[y_win], wx[x_win], inset.radiance)
+        values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: _band_major(inset.radiance)))
     coverage = np.outer(cover_y[y_win], cover_x[x_win])
     window = out[:, y_win, x_win]
     window *= (1.0 - coverage).astype(np.float32)
@@ -227,7 +241,7 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
 
 
 def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, cols: int, rows: int,
-                 extent: TanExtent) -> None:
+                 extent: TanExtent, *, once=_made_now) -> None:
     """Where ``out`` (band planes, a grid finer than the plate's, already holding the inset
     pasted at its own resolution) lies near the inset, show the inset at the plate's
     resolution except where ``inset.sharp`` keeps its own: the inset is pasted (its mean over
@@ -235,7 +249,8 @@ def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, co
     it, which are then interpolated onto the grid exactly as the plate is (low);
     out = low + sharp · (out - low). Away from the
     inset the cells are the plate's, so nothing changes there, and at the window's border
-    the composite has the plate's resolution on both sides: no step."""
+    the composite has the plate's resolution on both sides: no step. ``once`` as
+    :func:`_paste`'s (the cells do not depend on the target grid)."""
     e, (plate_rows, plate_cols) = plate.extent, plate.radiance.shape[:2]
     ppx, ppy = e.width / plate_cols, e.height / plate_rows
     i = inset.extent
@@ -247,8 +262,14 @@ def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, co
     if j1 <= j0 or r1 <= r0:
         return
     cells = TanExtent(e.x0 + j0 * ppx, e.y0 + r0 * ppy, e.x0 + j1 * ppx, e.y0 + r1 * ppy)
-    low_cells = np.ascontiguousarray(np.moveaxis(plate.radiance[r0:r1, j0:j1], 2, 0), dtype=np.float32)
-    _paste(low_cells, inset, j1 - j0, r1 - r0, cells, e, weighted=False)
+
+    def pasted_cells() -> np.ndarray:
+        low_cells = _band_major(plate.radiance[r0:r1, j0:j1])
+        _paste(low_cells, inset, j1 - j0, r1 - r0, cells, e, weighted=False, once=once)
+        low_cells.flags.writeable = False
+        return low_cells
+
+    low_cells = once(("cells", id(inset)), pasted_cells)
     # The grid's pixels whose centres have both neighbouring cell centres among these cells
     # (on the plate's border the plate clamps as these cells do): there, low is defined.
     tpx, tpy = extent.width / cols, extent.height / rows
@@ -264,7 +285,7 @@ def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, co
         return
     region = TanExtent(extent.x0 + c0 * tpx, extent.y0 + y0 * tpy, extent.x0 + c1 * tpx, extent.y0 + y1 * tpy)
     low_layer = RadianceLayer(np.moveaxis(low_cells, 0, 2), cells)
-    low = _apply(*_weights(low_layer, c1 - c0, y1 - y0, region), low_layer.radiance)
+    low = _apply(*_weights(low_layer, c1 - c0, y1 - y0, region), low_cells)
     # The share of each pixel's area that keeps the inset's own resolution (0 off the inset).
     n_rows, n_cols = inset.radiance.shape[:2]
     ox = _overlap_matrix(i.x0, i.x1, n_cols, region.x0, region.x1, c1 - c0)
@@ -312,12 +333,16 @@ def _linear_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: floa
     )
 
 
-def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, cube: np.ndarray) -> np.ndarray:
-    """Resample a (rows_in, cols_in, bands) cube to band planes (bands, rows, cols),
-    float32: columns first, by gathering each output column's few source columns
-    (at the layer's row count), then rows, by one sparse product over all bands."""
-    rows_in, cols_in, bands = cube.shape
-    planes = np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
+def _band_major(cube: np.ndarray) -> np.ndarray:
+    """A (rows, cols, bands) cube as C-contiguous float32 band planes (bands, rows, cols)."""
+    return np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
+
+
+def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, planes: np.ndarray) -> np.ndarray:
+    """Resample band planes (bands, rows_in, cols_in) (:func:`_band_major`) to band planes
+    (bands, rows, cols), float32: columns first, by gathering each output column's few
+    source columns (at the layer's row count), then rows, by one sparse product over all bands."""
+    bands, rows_in, cols_in = planes.shape
     idx, val = _taps(wx)
     tmp = np.take(planes, idx[:, 0], axis=2)
     tmp *= val[:, 0]

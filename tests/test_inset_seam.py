@@ -167,3 +167,19 @@ def test_seam_check_sees_the_window_and_not_the_fix(smoke_collection, load_bench
     assert before["window_de_p99"] > 2 * after["window_de_p99"]
     assert before["border_de_max_line"] > 2 * after["border_de_max_line"]
     assert before["detail_ratio"] > 1.1 > after["detail_ratio"]
+
+
+def test_a_scene_resampled_onto_several_grids_gives_each_what_a_fresh_scene_gives():
+    """What does not depend on the grid (the plate and the feathered inset band by band, the
+    inset pasted onto the plate's cells) is made once per scene and kept for its next grids
+    (a sweep's six pixel grids): each grid's composite is, bit for bit, a fresh scene's."""
+    plate, with_car, _, mask = _layers()
+    sharp = car_sharpness(mask, with_car.extent, plate.pixel_tan)
+    scene = _scene(plate, with_car, sharp)
+    grids = [(96, 54), (71, 40), (16, 9), (96, 54)]  # finer, finer, coarser than the plate, and back
+    for cols, rows in grids:
+        again = scene.resample(cols, rows)
+        np.testing.assert_array_equal(again, _scene(plate, with_car, sharp).resample(cols, rows))
+    kept = {key[0] for key in scene._grid_free}
+    assert kept == {"plate", "feathered", "inset", "cells"}
+    assert all(not a.flags.writeable for key, a in scene._grid_free.items() if key[0] == "cells")
