@@ -279,6 +279,64 @@ def test_a_multiscale_sweep_also_writes_the_sweeps_of_its_passes(serial_collecti
               also={640: tmp_path / "also-multiscale"}, **options)
 
 
+@pytest.mark.slow
+def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(serial_collection, tmp_path):
+    """A run interrupted after two scenes keeps its stage; the next run of the same camera,
+    condition, detector and seed takes it up (simulating only the scenes left) and writes the
+    files an uninterrupted run writes, a line cut by a kill included; another detector's run
+    does not take it up."""
+    require_model("yolov5n-dynamic.onnx")
+    from benchmark.detectors import load_detector
+    from benchmark.experiments import run as run_module
+    from metricscenes.store import Collection
+
+    collection = Collection.open(serial_collection)
+    camera = _small_cameras(tmp_path)[0]
+    detector = load_detector("yolov5n-dynamic", input_size="multiscale", model_dir=model_dir())
+    run_module.run_camera(collection, camera, "day", detector, tmp_path / "wholerun")
+
+    class Interrupted:  # the detector, stopped by Ctrl-C at its third scene
+        def __init__(self, calls):
+            self.calls = calls
+
+        def __getattr__(self, name):
+            return getattr(detector, name)
+
+        def detect(self, images, **kwargs):
+            self.calls.append(1)
+            if len(self.calls) == 3:
+                raise KeyboardInterrupt
+            return detector.detect(images, **kwargs)
+
+    out = tmp_path / "stopped"
+    with pytest.raises(KeyboardInterrupt):
+        run_module.run_camera(collection, camera, "day", Interrupted([]), out)
+    stage = out / run_module.RESUMABLE_STAGE
+    assert len((stage / run_module.CHECKPOINT).read_text().splitlines()) == 2 and not (out / "results.json").exists()
+    with open(stage / run_module.CHECKPOINT, "a") as f:
+        f.write('{"scene_id": "env001-d')  # a kill in the middle of the third line
+    simulated = []
+    original = run_module._CameraRun.add
+
+    def add(self, scene, *args):
+        if scene.scene_id not in self.done:
+            simulated.append(scene.scene_id)
+        original(self, scene, *args)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run_module._CameraRun, "add", add)
+        run_module.run_camera(collection, camera, "day", detector, out)
+    assert len(simulated) == len(collection.scenes()) - 2
+    assert _sweep_files(out) == _sweep_files(tmp_path / "wholerun") and not stage.exists()
+
+    with pytest.raises(KeyboardInterrupt):
+        run_module.run_camera(collection, camera, "day", Interrupted([]), tmp_path / "other")
+    at_640 = load_detector("yolov5n-dynamic", input_size=640, model_dir=model_dir())
+    stage = run_module.resumable_stage(tmp_path / "other", run_module.resume_key(camera, "day", collection, 0,
+                                                                                  [at_640], True, None))
+    assert not (stage / run_module.CHECKPOINT).exists()  # another detector's scenes: begun again
+
+
 # --- the backends themselves ---------------------------------------------------------------
 def test_map_units_gives_every_result_whatever_the_backend():
     units = [(2, n) for n in range(5)]

@@ -31,7 +31,6 @@ import hashlib
 import json
 import os
 import shutil
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -331,7 +330,10 @@ def run_camera(collection, camera, condition: str, detector, out_dir: Path, *, s
     ``out_dir`` as it was (the folders the run created are removed). The run holds
     ``out_dir/benchmark.lock`` (:func:`metricscenes.lock.output_lock`) throughout, so a second
     run on the same folder is refused (:class:`~metricscenes.lock.LockError`), and removes the
-    staging folders that killed runs left there.
+    staging folders that killed runs left there. A run killed or interrupted midway leaves its
+    resumable stage (:data:`RESUMABLE_STAGE`: each finished scene's detections, exposures and
+    image); the next run of the same :func:`resume_key` takes it up at the next scene and ends
+    with the same bytes as a run never stopped.
     """
     return run_cameras(collection, [camera], condition, detector, [out_dir], seed=seed, save_images=save_images,
                        backend=backend, progress=progress, captures=[captures])[0]
@@ -376,18 +378,28 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
     captured = [None if c is None else (Path(c), read_captures(c, camera, condition, collection, seed))
                 for camera, c in zip(cameras, captures)]
     created = [[p for p in (d, *d.parents) if not p.exists()] for d in every]
+    interrupted = False
     try:
         with ExitStack() as held:
             for d in every:
                 d.mkdir(parents=True, exist_ok=True)
                 held.enter_context(output_lock(d, "benchmark run", "run folder"))
                 remove_stale_stages(d)
-            stages = [[Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=d)) for d in dirs] for dirs in folders]
-            held.callback(lambda: [shutil.rmtree(stage, ignore_errors=True) for row in stages for stage in row])
+            keys = [resume_key(camera, condition, collection, seed, policies, save_images, c)
+                    for camera, c in zip(cameras, captures)]
+            stages = [[resumable_stage(d, keys[k]) for k, d in enumerate(dirs)] for dirs in folders]
+            # Removed when the runs succeed or fail; kept for the next run when they are
+            # interrupted (Ctrl-C here; a killed process runs nothing).
+            held.callback(lambda: interrupted or [shutil.rmtree(stage, ignore_errors=True)
+                                                  for row in stages for stage in row])
             runs = [_CameraRun(collection, camera, condition, policies, [row[k] for row in stages], field, window,
                                seed=seed, save_images=save_images, backend=backend, captures=c)
                     for k, (camera, window, c) in enumerate(zip(cameras, windows, captured))]
-            results = _run_scenes(collection, condition, runs, progress)
+            try:
+                results = _run_scenes(collection, condition, runs, progress)
+            except KeyboardInterrupt:
+                interrupted = True
+                raise
             for dirs, row in zip(folders, stages):
                 for d, stage in zip(dirs, row):
                     _move_into_place(stage, d, save_images)
@@ -413,12 +425,44 @@ def check_pass_policies(detector, sizes) -> None:
 
 
 STAGE_PREFIX = ".partial-"
+RESUMABLE_STAGE = STAGE_PREFIX + "resume"
+"""The staging folder a run writes scene by scene (``scenes.jsonl``: each finished scene's
+detections and exposures, written after its image) and a killed run resumes from."""
+STAGE_KEY = "resume-key.json"
+CHECKPOINT = "scenes.jsonl"
+
+
+def resume_key(camera, condition: str, collection, seed: int, detectors: list, save_images: bool,
+               captures) -> dict:
+    """What a staged run's scenes depend on: its capture key, the detectors' model and input
+    sizes (the own first), whether it saves images and the captures it reads. A stage of
+    another key is not resumed."""
+    return {"capture": capture_key(camera, condition, collection, seed),
+            "detectors": [[d.sha256, str(d.input_size), repr(getattr(d, "class_map", None))] for d in detectors],
+            "save_images": bool(save_images), "captures": None if captures is None else str(captures)}
+
+
+def resumable_stage(out_dir: Path, key: dict) -> Path:
+    """``out_dir``'s resumable staging folder: the one a run with the same ``key`` left
+    (killed or interrupted), else a new one (another key's is removed)."""
+    stage, text = out_dir / RESUMABLE_STAGE, json.dumps(key, sort_keys=True)
+    try:
+        if (stage / STAGE_KEY).read_text() == text:
+            return stage
+    except (OSError, UnicodeDecodeError):
+        pass
+    shutil.rmtree(stage, ignore_errors=True)
+    stage.mkdir()
+    (stage / STAGE_KEY).write_text(text)
+    return stage
 
 
 def remove_stale_stages(out_dir: Path) -> list[Path]:
     """Remove the staging folders (``.partial-*``) that runs killed in ``out_dir`` left
-    behind; the caller holds the folder's lock, so none is in use. Returns them."""
-    stale = sorted(p for p in out_dir.glob(f"{STAGE_PREFIX}*") if p.is_dir() and not p.is_symlink())
+    behind, but the resumable one (:func:`resumable_stage` judges it); the caller holds the
+    folder's lock, so none is in use. Returns them."""
+    stale = sorted(p for p in out_dir.glob(f"{STAGE_PREFIX}*")
+                   if p.is_dir() and not p.is_symlink() and p.name != RESUMABLE_STAGE)
     for folder in stale:
         shutil.rmtree(folder, ignore_errors=True)
     return stale
@@ -452,7 +496,7 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
     for i, scene in enumerate(scenes):
         record = collection.condition_record(scene.scene_id, condition)  # a targeted condition's weights, once
         radiance, read_s = None, 0.0
-        if any(run.captures is None for run in runs):
+        if any(run.captures is None and scene.scene_id not in run.done for run in runs):
             t = time.perf_counter()
             radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
             read_s = time.perf_counter() - t
@@ -484,6 +528,28 @@ class _CameraRun:
         self.exposures: dict[str, float] = {}
         self.short_exposures: dict[str, float] = {}  # the hdr policy's second frame
         self.targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
+        self.checkpoint = stages[0] / CHECKPOINT
+        self.done = self._staged_scenes()  # scenes an interrupted run of the same key finished
+
+    def _staged_scenes(self) -> dict[str, dict]:
+        """The scenes the checkpoint holds (a line cut by a kill is dropped, and the file
+        cut back to its last whole line so that the next scene starts a line of its own)."""
+        try:
+            data = self.checkpoint.read_bytes()
+        except FileNotFoundError:
+            return {}
+        whole = data[: data.rfind(b"\n") + 1]
+        if len(whole) != len(data):
+            with open(self.checkpoint, "r+b") as f:
+                f.truncate(len(whole))
+        done = {}
+        for line in whole.splitlines():
+            try:
+                entry = json.loads(line)
+            except ValueError:
+                continue
+            done[entry["scene_id"]] = entry
+        return done
 
     def add(self, scene, radiance, read_s: float, record: dict | None) -> None:
         """One scene: ``radiance`` its :class:`~metricscenes.radiance.SpectralScene` under the
@@ -497,6 +563,15 @@ class _CameraRun:
         camera, captures, timings = self.camera, self.captures, self.timings
         if record is not None:
             self.targeted[scene.scene_id] = record
+        staged = self.done.pop(scene.scene_id, None)
+        if staged is not None:  # finished before an interruption: its outputs are in the stage
+            for detections, found in zip(self.detections, staged["detections"]):
+                detections.extend(found)
+            self.exposures[scene.scene_id] = staged["exposure_s"]
+            if staged["exposure_short_s"] is not None:
+                self.short_exposures[scene.scene_id] = staged["exposure_short_s"]
+            return
+        found_here = [len(d) for d in self.detections]
         if captures is None:
             timings.seconds["read_radiance"] = timings.seconds.get("read_radiance", 0.0) + read_s
             t = time.perf_counter()
@@ -540,6 +615,11 @@ class _CameraRun:
             for stage in self.stages[1:]:
                 link_or_copy(source, stage / "images" / name)
             timings.add("save_images", t)
+        entry = {"scene_id": scene.scene_id, "detections": [d[n:] for d, n in zip(self.detections, found_here)],
+                 "exposure_s": self.exposures[scene.scene_id],
+                 "exposure_short_s": self.short_exposures.get(scene.scene_id)}
+        with open(self.checkpoint, "a") as f:  # after the image: a scene listed here is whole
+            f.write(json.dumps(entry) + "\n")
 
     def finish(self) -> RunResults:
         """Score and write every policy's stage; the detector's own run's results."""

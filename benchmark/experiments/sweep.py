@@ -12,7 +12,8 @@ only its missing (or stale) runs. A condition's missing runs are done together, 
 scene (:func:`benchmark.experiments.run.run_cameras`: each scene read once, resampled once per
 pixel grid), in as many groups of cameras as the backend runs at once (:func:`camera_groups`;
 on a running cluster, one group per pixel grid);
-a group killed midway is redone whole. The groups may go to worker processes or a dask cluster
+a group killed midway resumes at its next scene (each run's resumable stage:
+:func:`benchmark.experiments.run.resumable_stage`), with the same bytes. The groups may go to worker processes or a dask cluster
 (``workers``, ``scheduler``: :mod:`metricscenes.backends`); each run writes only its own run
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
 do not depend on where the runs ran.
