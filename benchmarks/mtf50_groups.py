@@ -1,0 +1,95 @@
+"""Cameras of one MTF50 group: do they detect alike? (Liu et al., EI 2023: "the object detection
+scores differed by as much as three standard deviations when the MTF50 was equal".)
+
+The paper's 13 cameras fall into four published MTF50 groups (55, 75, 100 and 150 cy/mm;
+``mtf50_group_cy_per_mm`` in their specs). For every pair in a group and every condition, the
+paired bootstrap of ``benchmark compare`` (the same environments resampled for both): ΔOD50
+± SD and its 95 % interval, |ΔOD50| / SD, and the distances where a difference in AP is
+called. ΔOD50 is not measured where either OD50 is censored (outside the measured distances).
+
+    PYTHONPATH=. python benchmarks/mtf50_groups.py --sweep results/quick --conditions day,night \\
+        --out docs/data/mtf50-groups.csv
+
+Prints the markdown table of docs/results.md ("Cameras of one MTF50 group").
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+from pathlib import Path
+
+import pandas as pd
+
+COLUMNS = ["condition", "group_cy_per_mm", "camera_a", "camera_b", "od50_a_m", "od50_b_m", "delta_od50_m",
+           "delta_od50_sd_m", "delta_od50_ci95_lo_m", "delta_od50_ci95_hi_m", "delta_over_sd", "resolved",
+           "n_resamples"]
+
+
+def group_pairs(cameras: list[str]) -> list[tuple[float, str, str]]:
+    """(group, camera a, camera b) for every pair of cameras of one published MTF50 group."""
+    from benchmark.camera import load_camera
+
+    groups: dict[float, list[str]] = {}
+    for name in cameras:
+        group = load_camera(name).mtf50_group_cy_per_mm
+        if group is not None:
+            groups.setdefault(float(group), []).append(name)
+    return [(g, a, b) for g in sorted(groups) for a, b in itertools.combinations(groups[g], 2)]
+
+
+def _od50(side: dict) -> str:
+    if side["censored"]:
+        return f"{side['censored']} {side['bound_m']:g}"
+    return "–" if side["od50_m"] is None else f"{side['od50_m']:.0f}"
+
+
+def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: int) -> tuple[pd.DataFrame, list[str]]:
+    from benchmark.experiments.compare import compare_paths
+    from benchmark.result_files import read_sweep_record
+
+    cameras = read_sweep_record(sweep / "sweep.json").cameras
+    rows, lines = [], []
+    for condition in conditions:
+        for group, a, b in group_pairs(cameras):
+            result = compare_paths(sweep, sweep, cameras=[a, b], condition=condition, n_resamples=n_resamples, seed=seed)
+            od = result["delta_od50"]
+            ratio = abs(od["delta_m"]) / od["sd_m"] if od["delta_m"] is not None and od["sd_m"] else None
+            resolved = " ".join(f"{r['distance_m']:g}{'+' if r['delta_ap'] > 0 else '−'}"
+                                for r in result["per_distance"] if r["resolved"])
+            rows.append({"condition": condition, "group_cy_per_mm": group, "camera_a": a, "camera_b": b,
+                         "od50_a_m": result["a"]["od50_m"], "od50_b_m": result["b"]["od50_m"],
+                         "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
+                         "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
+                         "delta_over_sd": ratio, "resolved": resolved, "n_resamples": result["n_resamples"]})
+            delta = ("censored" if od["delta_m"] is None else
+                     f"{od['delta_m']:+.0f} ± {od['sd_m']:.0f} [{od['ci95_m'][0]:+.0f}, {od['ci95_m'][1]:+.0f}]")
+            lines.append(f"| {condition} | {group:g} | {a} – {b} | {_od50(result['a'])} | {_od50(result['b'])} | {delta} | "
+                         f"{'–' if ratio is None else f'{ratio:.1f}'} | {resolved or 'none'} |")
+    return pd.DataFrame(rows, columns=COLUMNS), lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sweep", required=True, type=Path)
+    parser.add_argument("--conditions", default="day,night")
+    parser.add_argument("--resamples", type=int, default=1000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, help="CSV of the table")
+    args = parser.parse_args()
+    table, lines = compare_groups(args.sweep, args.conditions.split(","), args.resamples, args.seed)
+    if args.out:
+        table.to_csv(args.out, index=False, float_format="%.4f")
+    print("| condition | MTF50 group (cy/mm) | cameras A – B | OD50 A (m) | OD50 B (m) | ΔOD50 ± SD [95 %] (m) | "
+          "\\|Δ\\| / SD | ΔAP called at (m) |")
+    print("|---|---|---|---|---|---|---|---|")
+    print("\n".join(lines))
+    measured = table.dropna(subset=["delta_over_sd"])
+    for condition, part in measured.groupby("condition", sort=False):
+        big = part[part["delta_over_sd"] > 2]
+        print(f"- {condition}: {len(part)} pairs with both OD50s measured, {len(big)} differ by more than 2 SD"
+              + (f" (largest {part['delta_over_sd'].max():.1f} SD)" if len(part) else ""))
+
+
+if __name__ == "__main__":
+    main()
