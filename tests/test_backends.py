@@ -303,10 +303,13 @@ def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(seria
             return getattr(detector, name)
 
         def detect(self, images, **kwargs):
+            return self.detect_policies(images, **kwargs)[detector.input_size]
+
+        def detect_policies(self, images, *args, **kwargs):
             self.calls.append(1)
             if len(self.calls) == 3:
                 raise KeyboardInterrupt
-            return detector.detect(images, **kwargs)
+            return detector.detect_policies(images, *args, **kwargs)
 
     out = tmp_path / "stopped"
     with pytest.raises(KeyboardInterrupt):
@@ -329,12 +332,23 @@ def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(seria
     assert len(simulated) == len(collection.scenes()) - 2
     assert _sweep_files(out) == _sweep_files(tmp_path / "wholerun") and not stage.exists()
 
+    # With a pass's run beside it: its stage lost, the camera's scenes are all made again.
+    sibling = {640: [tmp_path / "stopped-640"]}
+    with pytest.raises(KeyboardInterrupt):
+        run_module.run_cameras(collection, [camera], "day", Interrupted([]), [out], also=sibling)
+    shutil.rmtree(tmp_path / "stopped-640" / run_module.RESUMABLE_STAGE)
+    simulated.clear()
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run_module._CameraRun, "add", add)
+        run_module.run_cameras(collection, [camera], "day", detector, [out], also=sibling)
+    assert len(simulated) == len(collection.scenes()) and _sweep_files(out) == _sweep_files(tmp_path / "wholerun")
+
     with pytest.raises(KeyboardInterrupt):
         run_module.run_camera(collection, camera, "day", Interrupted([]), tmp_path / "other")
     at_640 = load_detector("yolov5n-dynamic", input_size=640, model_dir=model_dir())
-    stage = run_module.resumable_stage(tmp_path / "other", run_module.resume_key(camera, "day", collection, 0,
-                                                                                  [at_640], True, None))
-    assert not (stage / run_module.CHECKPOINT).exists()  # another detector's scenes: begun again
+    stage, resumed = run_module.resumable_stage(tmp_path / "other", run_module.resume_key(
+        camera, "day", collection, 0, [at_640], True, None))
+    assert not resumed and not (stage / run_module.CHECKPOINT).exists()  # another detector's scenes: begun again
 
 
 # --- the backends themselves ---------------------------------------------------------------

@@ -387,7 +387,11 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
                 remove_stale_stages(d)
             keys = [resume_key(camera, condition, collection, seed, policies, save_images, c)
                     for camera, c in zip(cameras, captures)]
-            stages = [[resumable_stage(d, keys[k]) for k, d in enumerate(dirs)] for dirs in folders]
+            opened = [[resumable_stage(d, keys[k]) for k, d in enumerate(dirs)] for dirs in folders]
+            stages = [[stage for stage, _ in row] for row in opened]
+            for k in range(len(cameras)):  # a policy's stage begun again (its images gone): all of the camera's
+                if not all(row[k][1] for row in opened):
+                    (stages[0][k] / CHECKPOINT).unlink(missing_ok=True)
             # Removed when the runs succeed or fail; kept for the next run when they are
             # interrupted (Ctrl-C here; a killed process runs nothing).
             held.callback(lambda: interrupted or [shutil.rmtree(stage, ignore_errors=True)
@@ -442,19 +446,19 @@ def resume_key(camera, condition: str, collection, seed: int, detectors: list, s
             "save_images": bool(save_images), "captures": None if captures is None else str(captures)}
 
 
-def resumable_stage(out_dir: Path, key: dict) -> Path:
-    """``out_dir``'s resumable staging folder: the one a run with the same ``key`` left
-    (killed or interrupted), else a new one (another key's is removed)."""
+def resumable_stage(out_dir: Path, key: dict) -> tuple[Path, bool]:
+    """``out_dir``'s resumable staging folder and whether it is resumed: the one a run with
+    the same ``key`` left (killed or interrupted), else a new one (another key's is removed)."""
     stage, text = out_dir / RESUMABLE_STAGE, json.dumps(key, sort_keys=True)
     try:
         if (stage / STAGE_KEY).read_text() == text:
-            return stage
+            return stage, True
     except (OSError, UnicodeDecodeError):
         pass
     shutil.rmtree(stage, ignore_errors=True)
     stage.mkdir()
     (stage / STAGE_KEY).write_text(text)
-    return stage
+    return stage, False
 
 
 def remove_stale_stages(out_dir: Path) -> list[Path]:
