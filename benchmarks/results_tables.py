@@ -62,7 +62,8 @@ def _minus(text: str) -> str:
 def _od50_text(row, *, whole_metres: bool = False) -> str:
     """OD50 ± SD, the bound when censored, or the 95 % interval where the SD exceeds half the OD50."""
     if not row.get("censored") and np.isfinite(row["od50_m"]) and row["sd_m"] > row["od50_m"] / 2:
-        return f"{row['od50_m']:.0f} (95 %: {row['ci95_lo_m']:.0f}–{row['ci95_hi_m']:.0f})"
+        hi = "∞" if np.isinf(row["ci95_hi_m"]) else f"{row['ci95_hi_m']:.0f}"  # (resamples that never fall to 0.5)
+        return f"{row['od50_m']:.0f} (95 %: {row['ci95_lo_m']:.0f}–{hi})"
     return _od50_metres(row) if whole_metres else od50_cell(row)
 
 
