@@ -284,7 +284,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     also = {parse_input_size(size): run_module.check_out_dir(folder) for size, folder in (also or {}).items()}
     run_module.check_pass_policies(detector, also)
     for size, folder in also.items():
-        others = [out_dir, *(Path(captures_from) for _ in [1] if captures_from is not None),
+        others = [out_dir, *([Path(captures_from)] if captures_from is not None else []),
                   *(f for s, f in also.items() if s != size)]
         if any(folder.resolve() == other.resolve() for other in others):
             raise ValueError(f"the sweep folder for input size {size}, {folder}, is another of this sweep's folders")
@@ -299,7 +299,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         n_scenes = len(collection.scenes())
         total, done = n_scenes * len(cameras) * len(conditions), 0
         run_names = {(camera.name, condition): run_name(camera.name, condition, tags[camera.name]) + suffix
-                 for camera in cameras for condition in conditions}
+                     for camera in cameras for condition in conditions}
         run_dirs = {(size, *k): folders[size] / "runs" / name for size in folders for k, name in run_names.items()}
         results: dict[tuple, RunResults] = {}
         todo = []
