@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from pydantic import ValidationError
 
-from benchmark.camera.spec import ExposureSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec, ExposureSpec, SensorSpec
 from benchmark.camera.sensor import signal_volts_per_electron
 
 EXPOSURE_SYNTAX = ("auto_peak | mean_level | percentile:P | hdr[:RATIO] | fixed:SECONDS, "
@@ -203,3 +203,10 @@ def with_exposure(camera, policy: ExposureSpec | None):
     if policy is None:
         return camera
     return camera.model_copy(update={"exposure": policy})
+
+
+def reference_exposure_s(camera: CameraSpec) -> float:
+    """The exposure of the SNR reference: ``exposure_s`` for a ``fixed`` policy, else the
+    cap ``max_exposure_s`` (the longest any other policy may take)."""
+    e = camera.exposure
+    return float(e.exposure_s if e.mode == "fixed" else e.max_exposure_s)

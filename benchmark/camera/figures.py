@@ -15,19 +15,13 @@ from __future__ import annotations
 
 import math
 
+from benchmark.camera.exposure import reference_exposure_s
 from benchmark.camera.spec import MAX_CAPTURE_GIB, CameraSpec, plausibility_warnings
 
 REFERENCE_ILLUMINANCE_LUX = 100.0
 """Illuminance of the SNR reference: a 18 % grey Lambertian surface lit by 100 lux of D65."""
 REFERENCE_REFLECTANCE = 0.18
 REFERENCE_ILLUMINANT = "D65"
-
-
-def reference_exposure_s(camera: CameraSpec) -> float:
-    """The exposure of the SNR reference: ``exposure_s`` for a ``fixed`` policy, else the
-    cap ``max_exposure_s`` (the longest any other policy may take)."""
-    e = camera.exposure
-    return float(e.exposure_s if e.mode == "fixed" else e.max_exposure_s)
 
 
 def reference_signal_e_per_s(camera: CameraSpec) -> float:

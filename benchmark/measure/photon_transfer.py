@@ -143,7 +143,7 @@ def datasheet_figures(camera: CameraSpec, ptc: PhotonTransfer | None = None) -> 
     """The camera's EMVA-style figures from its photon transfer (JSON-ready, units in the
     keys): dark noise, saturation, dynamic range, SNR10 / SNR1 signal and illuminance, the
     maximum SNR, and the HDR transitions. Exposure: the camera's cap (its SNR reference)."""
-    from benchmark.camera.figures import reference_exposure_s
+    from benchmark.camera.exposure import reference_exposure_s
 
     exposure_s = reference_exposure_s(camera)
     ptc = ptc or photon_transfer(camera, exposure_s=exposure_s)
