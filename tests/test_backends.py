@@ -407,3 +407,18 @@ def test_sweep_refuses_an_unusable_scheduler_in_one_line(fakes, monkeypatch):  #
         assert result.exit_code == 2 and "Traceback" not in result.output
         assert len([line for line in result.output.splitlines() if line.strip()]) == 1 and message in result.output
         assert not (fakes / "sw").exists()
+
+
+def test_an_image_a_killed_run_had_begun_is_replaced_not_written_through(tmp_path):
+    """Resuming, a scene whose image a killed run had already linked (or copied) is linked
+    again: a target that is the source itself (a hard link) or a stale file is replaced."""
+    from benchmark.experiments.run import link_or_copy
+
+    source, target, other = tmp_path / "source.png", tmp_path / "target.png", tmp_path / "other.png"
+    source.write_bytes(b"new image")
+    link_or_copy(source, target)
+    link_or_copy(source, target)  # already a link to the source: no SameFileError
+    assert target.read_bytes() == b"new image" and target.stat().st_ino == source.stat().st_ino
+    other.write_bytes(b"old image")
+    link_or_copy(other, target)  # a stale target: replaced, the old source untouched
+    assert target.read_bytes() == b"old image" and source.read_bytes() == b"new image"

@@ -697,7 +697,9 @@ class _CameraRun:
 def link_or_copy(source: Path, target: Path) -> None:
     """``target`` as a hard link to ``source`` (a camera image is written once and never
     changed, so runs that share it need not hold a copy each), or a copy where the file
-    system cannot link."""
+    system cannot link. A ``target`` already there (a scene a killed run had begun) is
+    replaced, never written through: it may be a link to ``source`` itself."""
+    target.unlink(missing_ok=True)
     try:
         os.link(source, target)
     except OSError:
