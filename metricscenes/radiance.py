@@ -117,7 +117,7 @@ class SpectralScene:
         if key in self._last_resample:
             return self._last_resample[key]
         plate = self.layers[0]
-        out = _apply(*_weights(plate, cols, rows, extent), self._once(("plate",), lambda: _band_major(plate.radiance)))
+        out = _apply(*_weights(plate, cols, rows, extent), self._once(("plate",), lambda: band_planes(plate.radiance)))
         finer = (extent.width / cols < plate.pixel_tan[0] * (1 - 1e-9)
                  and extent.height / rows < plate.pixel_tan[1] * (1 - 1e-9))
         for inset in self.layers[1:]:
@@ -224,15 +224,15 @@ def _paste(out: np.ndarray, inset: RadianceLayer, cols: int, rows: int, extent: 
             # Resampled weighted radiance over resampled weight: the feathered mean of the
             # inset pixels a target pixel overlaps; it counts for their area times weight.
             mean_weight = np.outer(wy[y_win] @ feather_y, wx[x_win] @ feather_x)
-            values = _apply(wy[y_win], wx[x_win], once(("feathered", id(inset)), lambda: _band_major(
+            values = _apply(wy[y_win], wx[x_win], once(("feathered", id(inset)), lambda: band_planes(
                 inset.radiance * np.outer(feather_y, feather_x).astype(np.float32)[:, :, None])))
             values *= np.divide(1.0, mean_weight, out=np.zeros_like(mean_weight),
                                 where=mean_weight > 0).astype(np.float32)
         else:
-            values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: _band_major(inset.radiance)))
+            values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: band_planes(inset.radiance)))
         cover_x, cover_y = overlap_x @ feather_x, overlap_y @ feather_y
     else:
-        values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: _band_major(inset.radiance)))
+        values = _apply(wy[y_win], wx[x_win], once(("inset", id(inset)), lambda: band_planes(inset.radiance)))
     coverage = np.outer(cover_y[y_win], cover_x[x_win])
     window = out[:, y_win, x_win]
     window *= (1.0 - coverage).astype(np.float32)
@@ -264,7 +264,7 @@ def _match_plate(out: np.ndarray, inset: RadianceLayer, plate: RadianceLayer, co
     cells = TanExtent(e.x0 + j0 * ppx, e.y0 + r0 * ppy, e.x0 + j1 * ppx, e.y0 + r1 * ppy)
 
     def pasted_cells() -> np.ndarray:
-        low_cells = _band_major(plate.radiance[r0:r1, j0:j1])
+        low_cells = band_planes(plate.radiance[r0:r1, j0:j1])
         _paste(low_cells, inset, j1 - j0, r1 - r0, cells, e, weighted=False, once=once)
         low_cells.flags.writeable = False
         return low_cells
@@ -333,13 +333,15 @@ def _linear_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: floa
     )
 
 
-def _band_major(cube: np.ndarray) -> np.ndarray:
-    """A (rows, cols, bands) cube as C-contiguous float32 band planes (bands, rows, cols)."""
+def band_planes(cube: np.ndarray) -> np.ndarray:
+    """A (rows, cols, bands) cube as C-contiguous float32 band planes (bands, rows, cols): a
+    view when the cube is stored band by band (as :meth:`SpectralScene.resample` returns
+    it), else one copy."""
     return np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
 
 
 def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, planes: np.ndarray) -> np.ndarray:
-    """Resample band planes (bands, rows_in, cols_in) (:func:`_band_major`) to band planes
+    """Resample band planes (bands, rows_in, cols_in) (:func:`band_planes`) to band planes
     (bands, rows, cols), float32: columns first, by gathering each output column's few
     source columns (at the layer's row count), then rows, by one sparse product over all bands."""
     bands, rows_in, cols_in = planes.shape

@@ -40,6 +40,7 @@ import scipy.fft as sfft
 
 from benchmark.camera import lens as _lens
 from benchmark.camera.spec import OpticsSpec
+from metricscenes.radiance import band_planes
 
 FFT_WORKERS = 2
 _BATCH = 8  # spectra summed per matrix product (memory: 8 × the padded image, complex64)
@@ -155,13 +156,6 @@ def _pad(band: np.ndarray, pad: int, shape: tuple[int, int]) -> np.ndarray:
     rows, cols = band.shape
     out = np.pad(band, ((pad, shape[0] - rows - pad), (pad, shape[1] - cols - pad)), mode="symmetric")
     return out
-
-
-def band_planes(radiance: np.ndarray) -> np.ndarray:
-    """(rows, cols, bands) radiance as (bands, rows, cols) C-contiguous planes: a view
-    when the cube is stored band by band (as :meth:`SpectralScene.resample` returns
-    it), else one copy."""
-    return np.ascontiguousarray(np.moveaxis(np.asarray(radiance, dtype=np.float32), 2, 0))
 
 
 def veiling_glare(images: np.ndarray, optics: OpticsSpec, pixel_um: float) -> np.ndarray:
