@@ -27,10 +27,26 @@ COLUMNS = ["condition", "camera", "against", "od50_m", "od50_against_m", "delta_
            "delta_ap25_ci95_lo", "delta_ap25_ci95_hi", "resolved", "n_resamples", "verdict"]
 
 
-def _od50(side: dict) -> str:
+def od50_text(side: dict) -> str:
+    """One side of a ``compare`` result's OD50 in whole metres, or its bound when censored."""
     if side["censored"]:
         return f"{side['censored']} {side['bound_m']:g}"
     return "–" if side["od50_m"] is None else f"{side['od50_m']:.0f}"
+
+
+def delta_od50_text(result: dict) -> str:
+    """ΔOD50 ± SD [95 %] of a ``compare`` result, or "censored" where it is not measured."""
+    od = result["delta_od50"]
+    if od["delta_m"] is None:
+        return "censored"
+    return f"{od['delta_m']:+.0f} ± {od['sd_m']:.0f} [{od['ci95_m'][0]:+.0f}, {od['ci95_m'][1]:+.0f}]"
+
+
+def called_distances(result: dict) -> str:
+    """The distances where ``compare`` calls a difference in AP (interval excludes 0, backed
+    by found cars), each with the sign of A − B: "75− 100−"."""
+    return " ".join(f"{r['distance_m']:g}{'+' if r['delta_ap'] > 0 else '−'}"
+                    for r in result["per_distance"] if r["resolved"])
 
 
 def compare_variants(reference: Path, variants: Path, cameras: list[str], conditions: list[str], against: str,
@@ -44,10 +60,7 @@ def compare_variants(reference: Path, variants: Path, cameras: list[str], condit
             result = compare_paths(variants, reference, cameras=[camera, against], condition=condition,
                                    n_resamples=n_resamples, seed=seed)
             at25 = next(r for r in result["per_distance"] if r["distance_m"] == 25.0)
-            od = result["delta_od50"]
-            # distances where the difference is called (interval excludes 0, backed by found cars), with its sign
-            resolved = " ".join(f"{r['distance_m']:g}{'+' if r['delta_ap'] > 0 else '−'}"
-                                for r in result["per_distance"] if r["resolved"])
+            od, resolved = result["delta_od50"], called_distances(result)
             rows.append({
                 "condition": condition, "camera": camera, "against": against,
                 "od50_m": result["a"]["od50_m"], "od50_against_m": result["b"]["od50_m"],
@@ -58,9 +71,8 @@ def compare_variants(reference: Path, variants: Path, cameras: list[str], condit
                 "resolved": resolved,
                 "n_resamples": result["n_resamples"], "verdict": result["verdict"],
             })
-            delta_od = ("censored" if od["delta_m"] is None else
-                        f"{od['delta_m']:+.0f} ± {od['sd_m']:.0f} [{od['ci95_m'][0]:+.0f}, {od['ci95_m'][1]:+.0f}]")
-            lines.append(f"| {condition} | {camera} | {_od50(result['a'])} | {_od50(result['b'])} | {delta_od} | "
+            lines.append(f"| {condition} | {camera} | {od50_text(result['a'])} | {od50_text(result['b'])} | "
+                         f"{delta_od50_text(result)} | "
                          f"{at25['ap_a']:.2f} | {at25['ap_b']:.2f} | {at25['delta_ap']:+.2f} ± {at25['sd']:.2f} "
                          f"[{at25['ci95'][0]:+.2f}, {at25['ci95'][1]:+.2f}] | {resolved or 'none'} |")
     return pd.DataFrame(rows, columns=COLUMNS), lines

@@ -38,33 +38,25 @@ def group_pairs(cameras: list[str]) -> list[tuple[float, str, str]]:
     return [(g, a, b) for g in sorted(groups) for a, b in itertools.combinations(groups[g], 2)]
 
 
-def _od50(side: dict) -> str:
-    if side["censored"]:
-        return f"{side['censored']} {side['bound_m']:g}"
-    return "–" if side["od50_m"] is None else f"{side['od50_m']:.0f}"
-
-
 def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: int) -> tuple[pd.DataFrame, list[str]]:
     from benchmark.experiments.compare import compare_paths
     from benchmark.result_files import read_sweep_record
+    from camera_variants import called_distances, delta_od50_text, od50_text  # (benchmarks/, beside this script)
 
     cameras = read_sweep_record(sweep / "sweep.json").cameras
     rows, lines = [], []
     for condition in conditions:
         for group, a, b in group_pairs(cameras):
             result = compare_paths(sweep, sweep, cameras=[a, b], condition=condition, n_resamples=n_resamples, seed=seed)
-            od = result["delta_od50"]
+            od, resolved = result["delta_od50"], called_distances(result)
             ratio = abs(od["delta_m"]) / od["sd_m"] if od["delta_m"] is not None and od["sd_m"] else None
-            resolved = " ".join(f"{r['distance_m']:g}{'+' if r['delta_ap'] > 0 else '−'}"
-                                for r in result["per_distance"] if r["resolved"])
             rows.append({"condition": condition, "group_cy_per_mm": group, "camera_a": a, "camera_b": b,
                          "od50_a_m": result["a"]["od50_m"], "od50_b_m": result["b"]["od50_m"],
                          "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
                          "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
                          "delta_over_sd": ratio, "resolved": resolved, "n_resamples": result["n_resamples"]})
-            delta = ("censored" if od["delta_m"] is None else
-                     f"{od['delta_m']:+.0f} ± {od['sd_m']:.0f} [{od['ci95_m'][0]:+.0f}, {od['ci95_m'][1]:+.0f}]")
-            lines.append(f"| {condition} | {group:g} | {a} – {b} | {_od50(result['a'])} | {_od50(result['b'])} | {delta} | "
+            lines.append(f"| {condition} | {group:g} | {a} – {b} | {od50_text(result['a'])} | {od50_text(result['b'])} | "
+                         f"{delta_od50_text(result)} | "
                          f"{'–' if ratio is None else f'{ratio:.1f}'} | {resolved or 'none'} |")
     return pd.DataFrame(rows, columns=COLUMNS), lines
 

@@ -218,17 +218,17 @@ class OnnxDetector:
         for k, im in enumerate(images):
             if not (isinstance(im, np.ndarray) and im.ndim == 3 and im.shape[2] == 3 and im.dtype == np.uint8):
                 raise ValueError(f"images[{k}] must be an RGB uint8 array (H, W, 3), got {getattr(im, 'dtype', type(im))} {getattr(im, 'shape', '')}")
-        labels = self.pass_policies()
+        labels, also = self.pass_policies(), [parse_input_size(policy) for policy in also]
         for policy in also:
-            if parse_input_size(policy) not in labels:
+            if policy not in labels:
                 raise ValueError(f"input size {policy} is not one of this detector's passes "
                                  f"({', '.join(map(str, labels)) or 'it runs one'})")
         per_pass = [self._pass(images, p, conf_threshold, iou_threshold, max_det, multi_label) for p in self.passes]
         out = {self.input_size: [self._merged([r[i] for r in per_pass], iou_threshold, max_det)
                                  for i in range(len(images))]}
         for policy in also:
-            found = per_pass[labels.index(parse_input_size(policy))]
-            out[parse_input_size(policy)] = [self._merged([found[i]], iou_threshold, max_det) for i in range(len(images))]
+            found = per_pass[labels.index(policy)]
+            out[policy] = [self._merged([found[i]], iou_threshold, max_det) for i in range(len(images))]
         return out
 
     @staticmethod
