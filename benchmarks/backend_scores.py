@@ -1,0 +1,81 @@
+"""The same collection rendered by two backends (a CUDA GPU's and a CPU's), scored by the same
+sweep: does either give other scores than the other, beyond their bootstrap SD?
+
+Both collections hold the same scenes (the same manifest and seeds), so each camera's two runs
+are paired scene by scene: ``benchmark compare`` resamples the environments for both at once
+(each camera against itself). Beside the paired
+ΔOD50 the table gives each run's own bootstrap OD50 SD, the scale a reader of one collection
+sees. Where only some of a sweep's runs finished on one side, the cameras both hold are compared.
+
+    PYTHONPATH=. python benchmarks/backend_scores.py --cpu /work/results/m300-first8-cpu \\
+        --gpu /work/gpu2/sweep --conditions day --out docs/data/backend-scores.csv
+
+Prints the markdown table of docs/performance.md ("On a GPU").
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from camera_variants import called_distances, delta_od50_text, od50_text  # noqa: E402
+
+
+def finished_cameras(sweep: Path, condition: str) -> set[str]:
+    """Cameras whose run under ``condition`` finished in ``sweep`` (its results.json written last)."""
+    suffix = f"-{condition}"
+    return {p.parent.name[: -len(suffix)] for p in (sweep / "runs").glob(f"*{suffix}/results.json")}
+
+
+def compare_backends(gpu: Path, cpu: Path, condition: str, n_resamples: int, seed: int) -> tuple[list[dict], list[str]]:
+    """(table rows, markdown rows) for every camera whose run finished on both sides."""
+    from benchmark.experiments.compare import compare_paths
+    from benchmark.experiments.sweep import run_od50
+
+    rows, lines = [], []
+    for camera in sorted(finished_cameras(cpu, condition) & finished_cameras(gpu, condition)):
+        result = compare_paths(gpu, cpu, cameras=[camera], condition=condition, n_resamples=n_resamples, seed=seed)
+        own = [run_od50(folder / "runs" / f"{camera}-{condition}", n_resamples=n_resamples, seed=seed).sd_m
+               for folder in (gpu, cpu)]  # each run's own bootstrap (cached in its od50.json)
+        od = result["delta_od50"]
+        largest = max(abs(r["delta_ap"]) for r in result["per_distance"])
+        rows.append({"condition": condition, "camera": camera, "od50_gpu_m": result["a"]["od50_m"],
+                     "od50_cpu_m": result["b"]["od50_m"], "od50_sd_gpu_m": own[0], "od50_sd_cpu_m": own[1],
+                     "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
+                     "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
+                     "largest_abs_delta_ap": largest, "resolved": called_distances(result),
+                     "n_environments": result["n_environments"], "n_resamples": result["n_resamples"]})
+        lines.append(f"| {condition} | {camera} | {od50_text(result['a'])} | {od50_text(result['b'])} | "
+                     f"{own[0]:.0f} / {own[1]:.0f} | {delta_od50_text(result)} | {largest:.3f} | "
+                     f"{called_distances(result) or 'none'} |")
+    return rows, lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cpu", required=True, type=Path, help="sweep folder on the CPU's collection (B)")
+    parser.add_argument("--gpu", required=True, type=Path, help="sweep folder on the GPU's collection (A)")
+    parser.add_argument("--conditions", default="day")
+    parser.add_argument("--resamples", type=int, default=1000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, help="CSV of the table")
+    args = parser.parse_args()
+    rows, lines = [], []
+    for condition in args.conditions.split(","):
+        more_rows, more_lines = compare_backends(args.gpu, args.cpu, condition, args.resamples, args.seed)
+        rows += more_rows
+        lines += more_lines
+    if args.out:
+        pd.DataFrame(rows).to_csv(args.out, index=False, float_format="%.4f")
+    print("| condition | camera | OD50 GPU (m) | OD50 CPU (m) | own SD GPU / CPU (m) | ΔOD50 GPU − CPU ± SD [95 %] (m) | "
+          "largest \\|ΔAP\\| | ΔAP called at (m) |")
+    print("|---|---|---|---|---|---|---|---|")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
