@@ -53,6 +53,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -123,6 +124,13 @@ def _fingerprint(root: Path, path: str) -> tuple:
             st = p.stat()
             files.append((str(p.relative_to(folder)), st.st_ino, st.st_size, st.st_mtime_ns))
     return (str(folder.resolve()), *files)
+
+
+def remember_group_luminances(values: dict[tuple, float]) -> None:
+    """Keep in this process the group luminances another process measured
+    (:meth:`Collection.group_luminances`): the same keys (a file's version included), so a
+    changed file is measured again, and the same floats, so the same weights and bytes."""
+    _GROUP_LUMINANCE.update(values)
 
 
 def read_checked(root: Path, group, path: str, expected: str | None, label: str,
@@ -388,7 +396,7 @@ class Collection:
         self.check_condition(condition)
         if not isinstance(condition, str):
             return dict(condition)
-        if isinstance(self.conditions.get(condition), TargetedCondition):
+        if self.is_targeted(condition):
             return self.targeted_weights(scene_id, condition).weights
         if condition in self.conditions:
             return dict(self.conditions[condition])
@@ -422,12 +430,30 @@ class Collection:
 
     def group_luminance(self, scene_id: str, group: str) -> float:
         """:meth:`mean_luminance` of one light group at weight 1, kept per version of its files."""
+        return self._group_luminance_entry(scene_id, group)[1]
+
+    def _group_luminance_entry(self, scene_id: str, group: str) -> tuple[tuple, float]:
+        """(the key this process keeps it under, :meth:`group_luminance`)."""
         units = (f"plates/env{self._image(scene_id)['environment_id']:03d}", f"frames/{scene_id}", f"insets/{scene_id}")
         key = (str(self.root), scene_id, group,
                tuple(_fingerprint(self.root, f"{unit}/{group}") for unit in units if group in self._recorded.get(unit, [])))
         if key not in _GROUP_LUMINANCE:
             _GROUP_LUMINANCE[key] = self.mean_luminance(scene_id, {group: 1.0})
-        return _GROUP_LUMINANCE[key]
+        return key, _GROUP_LUMINANCE[key]
+
+    def is_targeted(self, condition: str) -> bool:
+        """Whether ``condition`` is set by a photometric target (its weights depend on the scene)."""
+        return isinstance(self.conditions.get(condition), TargetedCondition)
+
+    def group_luminances(self, scene_ids: Iterable[str], condition: str) -> dict[tuple, float]:
+        """The :meth:`group_luminance` of every light group a targeted ``condition`` weighs, in
+        these scenes (computed where this process has not yet), keyed as this process keeps
+        them: :func:`remember_group_luminances` in another process spares it the reading
+        (each is a whole scene read and resampled onto the reference grid: 0.7 core-s on metric-300)."""
+        self.check_condition(condition)
+        spec = self.conditions[condition]
+        groups = [spec.ambient, *(g for g, w in spec.lamps.items() if w != 0.0)]
+        return dict(self._group_luminance_entry(scene_id, group) for scene_id in scene_ids for group in groups)
 
     def targeted_weights(self, scene_id: str, condition: str) -> TargetedWeights:
         """A targeted condition's weights in one scene: its environment's target drawn from
@@ -445,7 +471,7 @@ class Collection:
 
     def condition_record(self, scene_id: str, condition: str) -> dict | None:
         """What a targeted condition did in a scene (target, weights, over target), else None."""
-        if isinstance(condition, str) and isinstance(self.conditions.get(condition), TargetedCondition):
+        if isinstance(condition, str) and self.is_targeted(condition):
             return self.targeted_weights(scene_id, condition).record()
         return None
 

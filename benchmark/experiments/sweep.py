@@ -160,21 +160,55 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
 def compute_runs(collection, cameras: list, condition: str, detector, run_dirs: list[Path], seed: int,
                  save_images: bool, backend: str, n_resamples: int, progress=None,
                  captures: list[Path | None] | None = None,
-                 also: dict | None = None) -> list[tuple[str, str, RunResults]]:
+                 also: dict | None = None, group_luminances: dict | None = None) -> list[tuple[str, str, RunResults]]:
     """Several cameras' runs under one condition (:func:`benchmark.experiments.run.run_cameras`:
     each scene read once for all of them) and their bootstrap OD50s, in whichever process the
     sweep's backend gives them: everything they write is in ``run_dirs`` (``od50.json`` too),
     which no other unit touches (``captures``, another sweep's run folders, are only read),
     and in ``also`` ({input size: run folders}: the runs of the detector's passes).
-    Returns (camera name, condition, results) per camera."""
+    ``group_luminances``: a targeted condition's light-group luminances measured already
+    (:func:`shared_group_luminances`). Returns (camera name, condition, results) per camera."""
     from benchmark.experiments import run as run_module
+    from metricscenes.store import remember_group_luminances
 
+    remember_group_luminances(group_luminances or {})
     results = run_module.run_cameras(collection, cameras, condition, detector, run_dirs, seed=seed,
                                      save_images=save_images, backend=backend, progress=progress, captures=captures,
                                      also=also)
     for run_dir in [*run_dirs, *(d for dirs in (also or {}).values() for d in dirs)]:
         run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
     return [(camera.name, condition, r) for camera, r in zip(cameras, results)]
+
+
+def measure_group_luminances(collection, scene_ids: list[str], conditions: list[str]) -> dict[str, dict]:
+    """One share of :func:`shared_group_luminances`, in whichever process the backend gives it."""
+    return {condition: collection.group_luminances(scene_ids, condition) for condition in conditions}
+
+
+def shared_group_luminances(collection, conditions: list[str], *, workers: int,
+                            scheduler: str | None) -> dict[str, dict]:
+    """{condition: its group luminances}: those the targeted ``conditions`` (the paper's night,
+    ``day_paper``) weigh in every scene, each measured once, the scenes shared among the
+    backend's workers a few environments each. Without them every unit of such a condition
+    measures every scene again (a whole scene read and resampled onto the reference grid per
+    light group: 2.8 core-s a scene for the paper's night on metric-300, here, in each unit)."""
+    from metricscenes.backends import map_units
+
+    targeted = [c for c in conditions if collection.is_targeted(c)]
+    if not targeted:
+        return {}
+    scenes = collection.scenes()
+    environments = sorted({s.environment_id for s in scenes})
+    # (an environment's scenes together: its plate, which all six share, is read by one worker)
+    shares = [[s.scene_id for s in scenes if s.environment_id in part]
+              for part in np.array_split(np.array(environments), min(len(environments), 4 * max(1, workers)))]
+    out: dict[str, dict] = {condition: {} for condition in targeted}
+    jobs = [(collection, share, targeted) for share in shares if share]
+    with closing(map_units(measure_group_luminances, jobs, workers=workers, scheduler=scheduler)) as measured:
+        for part in measured:
+            for condition, values in part.items():
+                out[condition].update(values)
+    return out
 
 
 def camera_groups(cameras: list, n_groups: int) -> list[list]:
@@ -331,6 +365,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
 
         # One unit per condition and group of cameras: each scene is read once per unit, and once
         # per pixel grid resampled; as many groups as the backend runs units at once.
+        luminances = {} if in_process else shared_group_luminances(
+            collection, sorted({c for _, c in todo}), workers=workers, scheduler=scheduler)
         jobs = []
         for condition in conditions:
             pending = [camera for camera, c in todo if c == condition]
@@ -341,7 +377,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                 jobs.append((collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
                              seed, save_images, backend, n_resamples, scene_progress(label, len(group)),
                              [captures(c, condition) for c in group],
-                             {size: [run_dirs[size, c.name, condition] for c in group] for size in also}))
+                             {size: [run_dirs[size, c.name, condition] for c in group] for size in also},
+                             luminances.get(condition)))
         with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
             for finished_runs in finished:  # in the order they finish
                 for camera_name, condition, run_results in finished_runs:
