@@ -2,13 +2,17 @@
 
     PYTHONPATH=. python benchmarks/results_tables.py publish --results results --out docs/data
     PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data
+    PYTHONPATH=. python benchmarks/results_tables.py publish --results results --collection metric-300 \
+        --out docs/data/metric-300
 
-``publish`` copies each sweep's ``sweep.csv`` and ``od50.csv`` into ``docs/data`` under the
-names the docs and tests/test_results_findings.py read (``-640``, ``-native``,
+``publish`` copies each sweep's ``sweep.csv`` and ``od50.csv`` (folders ``COLLECTION``,
+``COLLECTION-640``, ``-native``, ``-lux``, ``-day-paper``, ``-policy-…``; default ``quick``) into
+``docs/data`` under the names the docs and tests/test_results_findings.py read (``-640``, ``-native``,
 ``-illuminance``, ``-policies``; the policy tables gain an ``exposure`` column, the reference
 policy's rows coming from the reference sweep). ``markdown`` prints the tables of
 docs/results.md from those files: AP per distance with Spearman's ρ and OD50 per condition,
-the input-size comparison, the acquisition policies and the illuminance sweep.
+the input-size comparison, the acquisition policies and the illuminance sweep (those a
+folder holds: metric-300 has no native or policy sweeps).
 """
 
 from __future__ import annotations
@@ -23,35 +27,36 @@ from benchmark.experiments.acceptance import ap_distance_rho
 from benchmark.experiments.sweep import od50_cell, with_censoring
 
 REFERENCE_POLICY = "auto_peak (reference)"
-POLICIES = {"percentile:99": "quick-policy-percentile-99", "mean_level@0.18": "quick-policy-mean_level-0.18",
-            "hdr:16": "quick-policy-hdr-16"}
-SWEEPS = {"": "quick", "-640": "quick-640", "-native": "quick-native", "-illuminance": "quick-lux",
-          "-day-paper": "quick-day-paper"}
+POLICIES = {"percentile:99": "-policy-percentile-99", "mean_level@0.18": "-policy-mean_level-0.18",
+            "hdr:16": "-policy-hdr-16"}  # the sweep folders' names after the collection's
+SWEEPS = {"": "", "-640": "-640", "-native": "-native", "-illuminance": "-lux", "-day-paper": "-day-paper"}
 NIGHTS = ("night", "night_regulation")  # the paper's night, then the unlit regulation road
 POLICY_CONDITIONS = ("dusk", "night")  # the acquisition policies: dusk and the paper's night
 
 
-def publish(results: Path, out: Path) -> None:
-    """docs/data's CSVs from the sweep folders under ``results``."""
+def publish(results: Path, out: Path, collection: str = "quick") -> None:
+    """docs/data's CSVs from the sweep folders of ``collection`` under ``results``."""
     out.mkdir(parents=True, exist_ok=True)
-    for suffix, folder in SWEEPS.items():
+    for suffix, folder_suffix in SWEEPS.items():
+        folder = collection + folder_suffix
         if not (results / folder).is_dir():
             print(f"no {results / folder}: {out}/sweep{suffix}.csv and od50{suffix}.csv left as they are")
             continue
         for name in ("sweep", "od50"):
             (out / f"{name}{suffix}.csv").write_bytes((results / folder / f"{name}.csv").read_bytes())
-    if not all((results / folder / "sweep.csv").exists() for folder in POLICIES.values()):
+    policies = {policy: collection + folder_suffix for policy, folder_suffix in POLICIES.items()}
+    if not all((results / folder / "sweep.csv").exists() for folder in policies.values()):
         print(f"no policy sweeps under {results}: {out}/sweep-policies.csv and od50-policies.csv left as they are")
         return
-    reference_cameras = set(pd.read_csv(results / next(iter(POLICIES.values())) / "sweep.csv")["camera"])
+    reference_cameras = set(pd.read_csv(results / next(iter(policies.values())) / "sweep.csv")["camera"])
     for name in ("sweep", "od50"):
         parts = []
-        reference = pd.read_csv(results / "quick" / f"{name}.csv")
+        reference = pd.read_csv(results / collection / f"{name}.csv")
         reference = reference[reference["camera"].isin(reference_cameras)
                               & reference["condition"].isin(POLICY_CONDITIONS)]
         parts.append(reference.assign(exposure=REFERENCE_POLICY))
         parts += [pd.read_csv(results / folder / f"{name}.csv").assign(exposure=policy)
-                  for policy, folder in POLICIES.items()]
+                  for policy, folder in policies.items()]
         pd.concat(parts, ignore_index=True).to_csv(out / f"{name}-policies.csv", index=False)
 
 
@@ -202,8 +207,12 @@ def markdown(data: Path) -> str:
     parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])]
     if set(NIGHTS) <= set(table["condition"]):
         parts.append(f"### the nights side by side\n\n{three_nights_table(data)}")
-    parts += [f"### input size (day)\n\n{input_size_table(data)}", f"### policies\n\n{policy_tables(data)}",
-              f"### illuminance\n\n{illuminance_table(data)}"]
+    if (data / "od50-native.csv").exists() and (data / "od50-640.csv").exists():
+        parts.append(f"### input size (day)\n\n{input_size_table(data)}")
+    if (data / "od50-policies.csv").exists():
+        parts.append(f"### policies\n\n{policy_tables(data)}")
+    if (data / "od50-illuminance.csv").exists():
+        parts.append(f"### illuminance\n\n{illuminance_table(data)}")
     if (data / "od50-day-paper.csv").exists():
         parts.append(f"### day_paper\n\n{day_paper_table(data)}")
     if (data / "night-factors.csv").exists():
@@ -216,12 +225,13 @@ def main() -> None:
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("publish", help="copy the sweeps' tables into docs/data")
     p.add_argument("--results", type=Path, default=Path("results"))
+    p.add_argument("--collection", default="quick", help="the sweep folders' names begin with it")
     p.add_argument("--out", type=Path, default=Path("docs/data"))
     m = sub.add_parser("markdown", help="print docs/results.md's tables")
     m.add_argument("--data", type=Path, default=Path("docs/data"))
     args = parser.parse_args()
     if args.command == "publish":
-        publish(args.results, args.out)
+        publish(args.results, args.out, args.collection)
     else:
         print(markdown(args.data))
 

@@ -4,6 +4,7 @@ and `publish` lays the sweep folders out as docs/data."""
 from pathlib import Path
 
 import pandas as pd
+import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "docs" / "data"
@@ -18,22 +19,27 @@ def test_every_table_row_of_the_results_page_comes_from_docs_data(load_benchmark
     assert not missing, f"docs/results.md lacks (or has other numbers in) {missing[:3]}"
 
 
-def test_publish_lays_sweep_folders_out_as_docs_data(load_benchmark, tmp_path):
+@pytest.mark.parametrize("collection", ["quick", "metric-300"])
+def test_publish_lays_sweep_folders_out_as_docs_data(load_benchmark, tmp_path, collection):
     results_tables = load_benchmark("results_tables")
     results = tmp_path / "results"
-    for suffix, folder in results_tables.SWEEPS.items():
+    for suffix, folder_suffix in results_tables.SWEEPS.items():
         if not (DATA / f"sweep{suffix}.csv").exists():  # a sweep not yet published
             continue
-        (results / folder).mkdir(parents=True)
+        (results / (collection + folder_suffix)).mkdir(parents=True)
         for name in ("sweep", "od50"):
-            (results / folder / f"{name}.csv").write_bytes((DATA / f"{name}{suffix}.csv").read_bytes())
+            (results / (collection + folder_suffix) / f"{name}.csv").write_bytes((DATA / f"{name}{suffix}.csv").read_bytes())
+    (results / "other-640").mkdir()  # another collection's sweep is not taken
+    (results / "other-640" / "sweep.csv").write_text("camera\n")
     policies = pd.read_csv(DATA / "sweep-policies.csv"), pd.read_csv(DATA / "od50-policies.csv")
-    for policy, folder in results_tables.POLICIES.items():
-        (results / folder).mkdir()
+    for policy, folder_suffix in results_tables.POLICIES.items():
+        (results / (collection + folder_suffix)).mkdir()
         for name, table in zip(("sweep", "od50"), policies):
-            table[table["exposure"] == policy].drop(columns="exposure").to_csv(results / folder / f"{name}.csv", index=False)
+            table[table["exposure"] == policy].drop(columns="exposure").to_csv(
+                results / (collection + folder_suffix) / f"{name}.csv", index=False)
 
-    results_tables.publish(results, tmp_path / "data")
+    results_tables.publish(results, tmp_path / "data", collection)
+    assert (tmp_path / "data" / "sweep-640.csv").read_bytes() == (DATA / "sweep-640.csv").read_bytes()
 
     for name in ("sweep", "od50"):
         assert (tmp_path / "data" / f"{name}.csv").read_bytes() == (DATA / f"{name}.csv").read_bytes()
@@ -52,3 +58,14 @@ def test_publish_lays_sweep_folders_out_as_docs_data(load_benchmark, tmp_path):
     pd.testing.assert_frame_equal(made.sort_values(key).reset_index(drop=True)[list(policies[0].columns)],
                                   expected.sort_values(key).reset_index(drop=True)[list(policies[0].columns)],
                                   check_exact=False)
+
+
+def test_markdown_of_a_folder_without_native_or_policy_sweeps(load_benchmark, tmp_path):
+    """metric-300's folder (docs/data/metric-300) holds no native or policy sweeps."""
+    results_tables = load_benchmark("results_tables")
+    for suffix in ("", "-640", "-illuminance"):
+        for name in ("sweep", "od50"):
+            (tmp_path / f"{name}{suffix}.csv").write_bytes((DATA / f"{name}{suffix}.csv").read_bytes())
+    page = results_tables.markdown(tmp_path)
+    assert "### day" in page and "### illuminance" in page
+    assert "### policies" not in page and "### input size" not in page
