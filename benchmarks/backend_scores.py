@@ -3,9 +3,9 @@ sweep: does either give other scores than the other, beyond their bootstrap SD?
 
 Both collections hold the same scenes (the same manifest and seeds), so each camera's two runs
 are paired scene by scene: ``benchmark compare`` resamples the environments for both at once
-(each camera against itself). Beside the paired
-ΔOD50 the table gives each run's own bootstrap OD50 SD, the scale a reader of one collection
-sees. Where only some of a sweep's runs finished on one side, the cameras both hold are compared.
+(each camera against itself). Beside the paired ΔOD50 the table gives each run's own bootstrap
+OD50 SD, the scale a reader of one collection sees. Where only some of a sweep's runs finished
+on one side, the cameras both hold are compared.
 
     PYTHONPATH=. python benchmarks/backend_scores.py --cpu /work/results/m300-first8-cpu \\
         --gpu /work/gpu2/sweep --conditions day --out docs/data/backend-scores.csv
@@ -16,13 +16,10 @@ Prints the markdown table of docs/performance.md ("On a GPU").
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import pandas as pd
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from camera_variants import called_distances, delta_od50_text, od50_text  # noqa: E402
+from camera_variants import called_distances, delta_od50_text, od50_text  # (benchmarks/, beside this script)
 
 
 def finished_cameras(sweep: Path, condition: str) -> set[str]:

@@ -17,7 +17,8 @@ t0=$(date +%s)
 left() { echo $(( TOTAL - ($(date +%s) - t0) )); }
 
 python3 -m pip install -q --no-index --no-deps --no-compile --target /tmp/site .whl/*.whl \
-  && python3 -c "import zipfile; zipfile.ZipFile('.whl/mitsuba-stripped.zip').extractall('/tmp/site')" || exit 1
+  && python3 -c "import glob, zipfile; [zipfile.ZipFile(z).extractall('/tmp/site') for z in glob.glob('.whl/*.zip')]" \
+  || exit 1  # (mitsuba-stripped.zip, and the stripped colour packages of gpu_scored_environments.sh prepare)
 export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1
 { nvidia-smi -L; echo "cpus $(nproc)"; python3 --version; echo "installed in $(( $(date +%s) - t0 )) s"; } | tee "$OUT/info.txt"
 variant=$(python3 -c "from metricscenes.render import resolve_variant; print(resolve_variant('auto'))") || exit 1

@@ -126,6 +126,11 @@ def _fingerprint(root: Path, path: str) -> tuple:
     return (str(folder.resolve()), *files)
 
 
+def _lamps_on(spec: TargetedCondition) -> dict[str, float]:
+    """A targeted condition's lamp groups that it lights (weight > 0), with their weights."""
+    return {g: w for g, w in spec.lamps.items() if w != 0.0}
+
+
 def remember_group_luminances(values: dict[tuple, float]) -> None:
     """Keep in this process the group luminances another process measured
     (:meth:`Collection.group_luminances`): the same keys (a file's version included), so a
@@ -452,7 +457,7 @@ class Collection:
         (each is a whole scene read and resampled onto the reference grid: 0.7 core-s on metric-300)."""
         self.check_condition(condition)
         spec = self.conditions[condition]
-        groups = [spec.ambient, *(g for g, w in spec.lamps.items() if w != 0.0)]
+        groups = [spec.ambient, *_lamps_on(spec)]
         return dict(self._group_luminance_entry(scene_id, group) for scene_id in scene_ids for group in groups)
 
     def targeted_weights(self, scene_id: str, condition: str) -> TargetedWeights:
@@ -462,7 +467,7 @@ class Collection:
         spec = self.conditions[condition]
         env = self._image(scene_id)["environment_id"]
         target = draw_target_lux(self.manifest.seed, env, condition, spec.target_image_plane_lux)
-        lamps = {g: w for g, w in spec.lamps.items() if w != 0.0}
+        lamps = _lamps_on(spec)
         try:
             return ambient_weight(target, spec.f_number, self.group_luminance(scene_id, spec.ambient),
                                   {g: self.group_luminance(scene_id, g) for g in lamps}, lamps, spec.ambient)
