@@ -186,3 +186,20 @@ def test_the_gpus_collection_scores_as_the_cpus():
     assert (table["largest_abs_delta_ap"] < 0.1).all()
     called = table["resolved"].fillna("").str.split().str.len().sum()
     assert called <= 0.1 * 6 * len(table)
+
+
+def test_od50_sd_shrinks_counts_cameras_and_leaves_censored_ones_apart():
+    from benchmark.experiments.acceptance import od50_sd_shrinks
+
+    quick = pd.read_csv(DATA / "od50.csv", keep_default_na=False, na_values=[""])
+    day = quick[quick["condition"] == "day"]
+    larger = quick.copy()
+    measured = day[day["censored"].fillna("") == ""]["camera"].tolist()
+    halved = measured[:-1]  # all but one measured camera's SD halved
+    rows = (larger["condition"] == "day") & larger["camera"].isin(halved)
+    larger.loc[rows, "sd_m"] /= 2
+    found = od50_sd_shrinks(larger, quick)
+    assert found["compared"] == len(measured) and found["smaller"] == len(halved)
+    assert found["censored"] == day["camera"].nunique() - len(measured)
+    with pytest.raises(ValueError, match="no 'dawn' rows"):
+        od50_sd_shrinks(larger, quick, condition="dawn")

@@ -171,3 +171,27 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
         "night_od50_rises_with_mtf50": bool(rho > 0),
         "night_od50_mtf50_rho": rho,
     }
+
+
+def od50_sd_shrinks(od50: pd.DataFrame, smaller_collection_od50: pd.DataFrame, *, condition: str = "day") -> dict:
+    """A larger collection's bootstrap OD50 SDs against a smaller one's (issue 25: metric-300's
+    day SDs below quick's for at least 11 of 13 cameras), camera by camera under ``condition``.
+    Cameras whose OD50 is censored on either side (its SD measures the edge of the distances,
+    not the spread) are counted apart, not compared.
+
+    Returns ``smaller`` (cameras whose SD is below the smaller collection's), ``compared``
+    and ``censored`` (counts), and ``ratio_median`` (median SD ratio, large / small, NaN when
+    none is compared)."""
+    def sds(table):
+        part = table[table["condition"] == condition].set_index("camera")
+        if part.empty:
+            raise ValueError(f"od50 table has no {condition!r} rows")
+        censored = part["censored"].fillna("").astype(str).str.len() > 0 if "censored" in part else False
+        return part["sd_m"].where(~censored & np.isfinite(part["od50_m"]))
+
+    large, small = sds(od50), sds(smaller_collection_od50)
+    cameras = large.index.intersection(small.index)
+    both = large[cameras].notna() & small[cameras].notna()
+    ratio = (large[cameras] / small[cameras])[both]
+    return {"smaller": int((ratio < 1).sum()), "compared": int(both.sum()), "censored": int((~both).sum()),
+            "ratio_median": float(ratio.median()) if both.any() else float("nan")}
