@@ -19,7 +19,7 @@ import argparse
 from pathlib import Path
 
 import pandas as pd
-from camera_variants import called_distances, delta_od50_text, od50_text  # (benchmarks/, beside this script)
+from camera_variants import called_distances, delta_od50_columns, delta_od50_text, od50_text  # (benchmarks/, beside this script)
 
 
 def finished_cameras(sweep: Path, condition: str) -> set[str]:
@@ -38,17 +38,15 @@ def compare_backends(gpu: Path, cpu: Path, condition: str, n_resamples: int, see
         result = compare_paths(gpu, cpu, cameras=[camera], condition=condition, n_resamples=n_resamples, seed=seed)
         own = [run_od50(folder / "runs" / f"{camera}-{condition}", n_resamples=n_resamples, seed=seed).sd_m
                for folder in (gpu, cpu)]  # each run's own bootstrap (cached in its od50.json)
-        od = result["delta_od50"]
-        largest = max(abs(r["delta_ap"]) for r in result["per_distance"])
+        largest, called = max(abs(r["delta_ap"]) for r in result["per_distance"]), called_distances(result)
         rows.append({"condition": condition, "camera": camera, "od50_gpu_m": result["a"]["od50_m"],
                      "od50_cpu_m": result["b"]["od50_m"], "od50_sd_gpu_m": own[0], "od50_sd_cpu_m": own[1],
-                     "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
-                     "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
-                     "largest_abs_delta_ap": largest, "resolved": called_distances(result),
+                     **delta_od50_columns(result),
+                     "largest_abs_delta_ap": largest, "resolved": called,
                      "n_environments": result["n_environments"], "n_resamples": result["n_resamples"]})
         lines.append(f"| {condition} | {camera} | {od50_text(result['a'])} | {od50_text(result['b'])} | "
                      f"{own[0]:.0f} / {own[1]:.0f} | {delta_od50_text(result)} | {largest:.3f} | "
-                     f"{called_distances(result) or 'none'} |")
+                     f"{called or 'none'} |")
     return rows, lines
 
 

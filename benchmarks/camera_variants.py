@@ -42,6 +42,14 @@ def delta_od50_text(result: dict) -> str:
     return f"{od['delta_m']:+.0f} ± {od['sd_m']:.0f} [{od['ci95_m'][0]:+.0f}, {od['ci95_m'][1]:+.0f}]"
 
 
+def delta_od50_columns(result: dict) -> dict:
+    """A ``compare`` result's ΔOD50, its SD and 95 % interval as the tables' four columns
+    (None where either OD50 is censored)."""
+    od = result["delta_od50"]
+    return {"delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
+            "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1]}
+
+
 def called_distances(result: dict) -> str:
     """The distances where ``compare`` calls a difference in AP (interval excludes 0, backed
     by found cars), each with the sign of A − B: "75− 100−"."""
@@ -60,12 +68,11 @@ def compare_variants(reference: Path, variants: Path, cameras: list[str], condit
             result = compare_paths(variants, reference, cameras=[camera, against], condition=condition,
                                    n_resamples=n_resamples, seed=seed)
             at25 = next(r for r in result["per_distance"] if r["distance_m"] == 25.0)
-            od, resolved = result["delta_od50"], called_distances(result)
+            resolved = called_distances(result)
             rows.append({
                 "condition": condition, "camera": camera, "against": against,
                 "od50_m": result["a"]["od50_m"], "od50_against_m": result["b"]["od50_m"],
-                "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
-                "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
+                **delta_od50_columns(result),
                 "ap25": at25["ap_a"], "ap25_against": at25["ap_b"], "delta_ap25": at25["delta_ap"],
                 "delta_ap25_sd": at25["sd"], "delta_ap25_ci95_lo": at25["ci95"][0], "delta_ap25_ci95_hi": at25["ci95"][1],
                 "resolved": resolved,

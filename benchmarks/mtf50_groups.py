@@ -41,7 +41,7 @@ def group_pairs(cameras: list[str]) -> list[tuple[float, str, str]]:
 def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: int) -> tuple[pd.DataFrame, list[str]]:
     from benchmark.experiments.compare import compare_paths
     from benchmark.result_files import read_sweep_record
-    from camera_variants import called_distances, delta_od50_text, od50_text  # (benchmarks/, beside this script)
+    from camera_variants import called_distances, delta_od50_columns, delta_od50_text, od50_text  # (benchmarks/, beside this script)
 
     cameras = read_sweep_record(sweep / "sweep.json").cameras
     rows, lines = [], []
@@ -52,8 +52,7 @@ def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: i
             ratio = abs(od["delta_m"]) / od["sd_m"] if od["delta_m"] is not None and od["sd_m"] else None
             rows.append({"condition": condition, "group_cy_per_mm": group, "camera_a": a, "camera_b": b,
                          "od50_a_m": result["a"]["od50_m"], "od50_b_m": result["b"]["od50_m"],
-                         "delta_od50_m": od["delta_m"], "delta_od50_sd_m": od["sd_m"],
-                         "delta_od50_ci95_lo_m": od["ci95_m"][0], "delta_od50_ci95_hi_m": od["ci95_m"][1],
+                         **delta_od50_columns(result),
                          "delta_over_sd": ratio, "resolved": resolved, "n_resamples": result["n_resamples"]})
             lines.append(f"| {condition} | {group:g} | {a} – {b} | {od50_text(result['a'])} | {od50_text(result['b'])} | "
                          f"{delta_od50_text(result)} | "

@@ -186,7 +186,7 @@ def od50_sd_shrinks(od50: pd.DataFrame, smaller_collection_od50: pd.DataFrame, *
         part = table[table["condition"] == condition].set_index("camera")
         if part.empty:
             raise ValueError(f"od50 table has no {condition!r} rows")
-        censored = part["censored"].fillna("").astype(str).str.len() > 0 if "censored" in part else False
+        censored = part["censored"].fillna("").astype(str).str.len() > 0 if "censored" in part else pd.Series(False, part.index)
         return part["sd_m"].where(~censored & np.isfinite(part["od50_m"]))
 
     large, small = sds(od50), sds(smaller_collection_od50)
