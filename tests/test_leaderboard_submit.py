@@ -217,7 +217,7 @@ def test_render_deterministic_and_ranked(app, populated, tmp_path):
         day = subs[name]["conditions"]["day"]
         assert f"[{name}](submissions/{name}.json)" in text
         assert f"{day['od50_m']:.1f} ± {day['od50_sd_m']:.1f}" in text
-    assert "benchmark submit sweeps/quick --name 'ref-{camera}-yolov5n-quick'" in text
+    assert 'benchmark submit sweeps/$c --name "ref-{camera}-yolov5n-$c"' in text and 'for c in quick metric-300' in text
     assert "http://" not in page.decode() and "https://" not in page.decode() and "src=" not in page.decode()
     # same inputs, same bytes: again, and in another folder
     other = tmp_path / "copy"
