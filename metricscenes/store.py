@@ -482,10 +482,16 @@ class Collection:
 
     def photometry(self, scene_id: str, condition: str | dict[str, float], f_number: float = 2.4) -> dict:
         """Horizontal illuminance at the camera, mean scene luminance over the field of
-        view, and the mean image-plane illuminance of an ideal f/N lens."""
+        view, and the mean image-plane illuminance of an ideal f/N lens.
+
+        The luminance is the weighted sum of the light groups' (:meth:`group_luminance`, kept
+        per scene): mixing, compositing, resampling and the mean are linear, so it is the mix's
+        own (:meth:`mean_luminance`) to the rounding, and a scene's groups are read once for
+        all its conditions (a targeted condition's weights need them anyway)."""
         from metricscenes.photometry import image_plane_illuminance_lux
 
-        luminance = self.mean_luminance(scene_id, condition)
+        weights = self._weights(condition, scene_id)
+        luminance = float(sum(w * self.group_luminance(scene_id, g) for g, w in weights.items() if w != 0.0))
         out = {
             "scene_id": scene_id, "condition": condition if isinstance(condition, str) else dict(condition),
             "illuminance_at_camera_lux": self.illuminance_lux(scene_id, condition),

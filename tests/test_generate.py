@@ -199,6 +199,16 @@ def test_photometry_and_illuminance_sweep(smoke_collection):
     assert day["image_plane_illuminance_lux"] == pytest.approx(np.pi * day["mean_luminance_cd_m2"] / (1 + 4 * 2.4**2))
 
 
+def test_photometry_sums_the_groups_as_the_mix_measures(smoke_collection):
+    """photometry() adds the light groups' luminances; the mix's own, measured, agrees (linear
+    to the rounding) in every scene under every condition, targeted ones included."""
+    c = Collection.open(smoke_collection)
+    for scene in c.scenes()[::5]:
+        for condition in c.held_condition_names:
+            summed = c.photometry(scene.scene_id, condition)["mean_luminance_cd_m2"]
+            assert summed == pytest.approx(c.mean_luminance(scene.scene_id, condition), rel=1e-5), (scene, condition)
+
+
 def test_illuminance_sweep_keeps_lamps_on(smoke_collection):
     """``lamps_on`` groups join every sweep level at weight 1, the ambient group is scaled."""
     c = Collection.open(smoke_collection)

@@ -14,6 +14,7 @@ import pytest
 from scipy import stats
 
 from metricscenes.manifest import ManifestError, load_manifest, parse_manifest
+from metricscenes.photometry import image_plane_illuminance_lux
 from metricscenes.store import Collection
 from metricscenes.targets import ambient_weight, draw_target_lux
 
@@ -42,7 +43,7 @@ def test_every_smoke_scene_meets_its_target(smoke_collection):
     c = Collection.open(smoke_collection)
     for scene in c.scenes():
         rec = c.targeted_weights(scene.scene_id, "night")
-        lux = c.photometry(scene.scene_id, "night")["image_plane_illuminance_lux"]
+        lux = image_plane_illuminance_lux(c.mean_luminance(scene.scene_id, "night"), 2.4)  # the mix, measured
         if rec.over_target:
             assert rec.lamps_lux > rec.target_lux and lux == pytest.approx(rec.lamps_lux, rel=1e-3)
         else:
