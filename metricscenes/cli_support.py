@@ -33,7 +33,8 @@ class LogProgress:
     """Progress for a log file: a plain line every ``step`` of the units or every ``every_s``
     seconds, whichever comes first (units done, elapsed, estimated remaining). What
     :func:`progress_bar` gives where its console is not a terminal (``rich`` would print
-    nothing until the end)."""
+    nothing until the end). The first count reported is work found done (a resumed run's):
+    the remaining time is estimated from the units done after it."""
 
     def __init__(self, console: Console, step: float = 0.05, every_s: float = 30.0, clock=time.monotonic):
         self.console, self.step, self.every_s, self.clock = console, step, every_s, clock
@@ -42,7 +43,7 @@ class LogProgress:
     def add_task(self, description: str, total: float | None = None, **_) -> int:
         now = self.clock()
         self.tasks[len(self.tasks)] = {"description": description, "total": total, "completed": 0,
-                                       "started": now, "printed_at": now, "printed_fraction": 0.0}
+                                       "started": now, "printed_at": now, "printed_fraction": 0.0, "found": None}
         return len(self.tasks) - 1
 
     def update(self, task: int, completed: float | None = None, total: float | None = None,
@@ -52,6 +53,8 @@ class LogProgress:
             if value is not None:
                 t[key] = value
         now = self.clock()
+        if t["found"] is None and completed is not None:
+            t["found"] = (t["completed"], now)
         fraction = t["completed"] / t["total"] if t["total"] else 0.0
         done = bool(t["total"]) and t["completed"] >= t["total"]
         if done or fraction >= t["printed_fraction"] + self.step or now - t["printed_at"] >= self.every_s:
@@ -67,7 +70,9 @@ class LogProgress:
         if not t["total"]:
             return f"{t['description']}: {t['completed']:g} done, {_duration(elapsed)} elapsed"
         fraction = t["completed"] / t["total"]
-        left = f", about {_duration(elapsed * (1 - fraction) / fraction)} left" if 0 < fraction < 1 else ""
+        found, found_at = t["found"] or (0, t["started"])
+        rate = (t["completed"] - found) / (now - found_at) if now > found_at else 0.0
+        left = f", about {_duration((t['total'] - t['completed']) / rate)} left" if 0 < fraction < 1 and rate > 0 else ""
         return (f"{t['description']}: {t['completed']:g}/{t['total']:g} ({100 * fraction:.0f} %), "
                 f"{_duration(elapsed)} elapsed{left}")
 

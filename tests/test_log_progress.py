@@ -41,6 +41,19 @@ def test_slow_units_print_every_thirty_seconds():
     assert len(_lines(out)) == 5  # at 40, 80, 120, 160 and 200 s
 
 
+def test_a_resumed_run_estimates_from_the_units_it_renders():
+    """generate reports the units found done first: they took no time in this run."""
+    out = io.StringIO()
+    now = [0.0]
+    progress = LogProgress(Console(file=out, width=200), clock=lambda: now[0])
+    task = progress.add_task("rendering metric-300", total=None)
+    progress.update(task, completed=112, total=350)
+    for done in range(113, 120):  # then a unit every 100 s
+        now[0] += 100.0
+        progress.update(task, completed=done)
+    assert _lines(out)[-1] == "rendering metric-300: 119/350 (34 %), 11 min 40 s elapsed, about 6 h 25 min left"
+
+
 def test_progress_bar_is_plain_lines_off_a_terminal_and_rich_on_one():
     with progress_bar(Console(file=io.StringIO())) as bar:
         assert isinstance(bar, LogProgress)

@@ -347,9 +347,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                     continue
                 results.update({(size, camera.name, condition): r for size, r in cached.items()})
                 done += n_scenes
-                if progress:
-                    progress(done, total, f"{camera.name} · {condition}")
         reused = {(camera_name, condition) for size, camera_name, condition in results}
+        if progress and reused:  # at once: the log's estimate of the time left counts the runs done after it
+            progress(done, total, f"{len(reused)} runs cached")
 
         in_process = runs_in_process(workers, scheduler)
 
