@@ -127,7 +127,7 @@ def info(
     try:
         c = Collection.open(collection)
     except _user_errors() as exc:
-        fail(str(exc))
+        fail(f"{exc}{_generating_now(collection)}")
     scenes = c.scenes()
     size = sum(p.stat().st_size for p in (collection / "radiance.zarr").rglob("*") if p.is_file())
     summary = {
@@ -160,6 +160,15 @@ def info(
                       f"with: {c.generate_command()}", highlight=False, soft_wrap=True)
 
 
+def _generating_now(collection: Path) -> str:
+    """' (PID … on host … since … is generating it now: …)' where a live ``generate`` holds the
+    collection's lock (what it lacks may just not be written yet), else ''."""
+    from metricscenes.lock import describe, writer
+
+    holder = writer(collection)
+    return f" ({describe(holder)} is generating it now: wait for it)" if holder else ""
+
+
 def _photometry_table(rows: list[dict]) -> None:
     """Mean over scenes, per condition."""
     table = Table(title="photometry (mean over scenes; --json: each scene, and a targeted condition's weights)")
@@ -186,8 +195,8 @@ def verify(collection: Annotated[Path, typer.Argument(help="collection folder")]
     for line in problems:
         console.print(f"bad: {line}", highlight=False, soft_wrap=True)
     if problems:
-        fail(f"{collection}: {len(problems)} problem(s); rerun `metricscenes generate` with its manifest to repair it",
-             code=1)
+        fail(f"{collection}: {len(problems)} problem(s); rerun `metricscenes generate` with its manifest to repair it"
+             f"{_generating_now(collection)}", code=1)
     for line in upgrade_notes(collection):
         console.print(f"note: {collection}: {line}", highlight=False, soft_wrap=True)
     console.print("manifest, arrays, their attributes and ground truth match their records")

@@ -57,6 +57,19 @@ def _alive(holder: dict) -> bool:
     return started is None or now is None or started == now
 
 
+def writer(root: str | Path, lock_file: str = LOCK_FILE) -> dict | None:
+    """Who its lock file says is writing ``root`` (PID, host, since, command), or None: no
+    lock file, or a stale one (its process gone, on this host). Reads the file only: taking
+    even a shared ``flock`` could turn a writer starting at that moment away."""
+    try:
+        holder = json.loads((Path(root) / lock_file).read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    if not isinstance(holder, dict) or (holder.get("host") == socket.gethostname() and not _alive(holder)):
+        return None
+    return holder
+
+
 def output_lock(root: str | Path, command: str, what: str, notice=None):
     """:func:`folder_lock` on a run or sweep folder's ``benchmark.lock``."""
     return folder_lock(root, command, what, notice=notice, lock_file=OUTPUT_LOCK_FILE)

@@ -273,6 +273,9 @@ class Collection:
         root = Path(path)
         if not root.is_dir():
             raise CollectionError(f"{root}: no such collection folder")
+        unfinished = unfinished_generation(root)
+        if unfinished:
+            raise CollectionError(f"{root}: not a complete collection: {unfinished}")
         for name in (RESOLVED_MANIFEST_FILE, GROUNDTRUTH_FILE, RADIANCE_STORE):
             if not (root / name).exists():
                 raise CollectionError(
@@ -778,6 +781,17 @@ def upgrade_notes(path: str | Path) -> list[str]:
     return [ATTRIBUTES_UPGRADE_NOTE] if resolved.attributes_sha256 is None and resolved.arrays else []
 
 
+def unfinished_generation(root: str | Path) -> str | None:
+    """What a collection whose ``generate`` has not finished holds so far (units recorded in
+    ``progress/``; the resolved manifest and ground truth come after the last), else None."""
+    root = Path(root)
+    if (root / RESOLVED_MANIFEST_FILE).exists() or not (root / PROGRESS_DIR).is_dir():
+        return None
+    done = len(list((root / PROGRESS_DIR).glob("*.json")))
+    return (f"its generation has not finished ({done} units done; {RESOLVED_MANIFEST_FILE} and {GROUNDTRUTH_FILE} "
+            "are written after the last): rerun `metricscenes generate` to finish it")
+
+
 def verify_collection(path: str | Path) -> list[str]:
     """Check a whole collection; return every problem, one line each naming its scene
     (plates: their environment): the resolved manifest (parses, manifest and content
@@ -789,15 +803,18 @@ def verify_collection(path: str | Path) -> list[str]:
     root = Path(path)
     if not root.is_dir():
         return [f"{root}: no such collection folder"]
-    problems = []
     resolved = groundtruth = None
+    unfinished = unfinished_generation(root)
+    problems = [unfinished] if unfinished else []  # (then its units' arrays are checked against their records)
     try:
-        resolved = _load_resolved(root)
-        _parse_manifest(root, resolved)
+        if not unfinished:
+            resolved = _load_resolved(root)
+            _parse_manifest(root, resolved)
     except CollectionError as exc:
         problems.append(str(exc).removeprefix(f"{root}: "))
     try:
-        groundtruth = _load_groundtruth(root)
+        if not unfinished or (root / GROUNDTRUTH_FILE).exists():
+            groundtruth = _load_groundtruth(root)
     except CollectionError as exc:
         problems.append(str(exc).removeprefix(f"{root}: "))
     if resolved is not None:
