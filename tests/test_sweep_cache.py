@@ -211,7 +211,8 @@ def test_table_shape_and_columns(tmp_path, monkeypatch):
     meta = json.loads((tmp_path / "sw" / "sweep.json").read_text())
     assert len(meta["table"]) == len(table) and meta["cameras"] == list(CAMERAS)
     total = len(CAMERAS) * 2 * 6 * N_ENV
-    assert events[-1] == (total, total) and all(a[0] <= b[0] for a, b in zip(events, events[1:]))
+    assert events[0] == (0, total) and events[-1] == (total, total)
+    assert all(a[0] <= b[0] for a, b in zip(events, events[1:]))
     again = []  # every run cached: reported at once (a log estimates the time left from the runs after it)
     make_fake_sweep(tmp_path / "sw", monkeypatch, progress=lambda d, t, label: again.append((d, t, label)))
     assert again == [(total, total, f"{len(CAMERAS) * 2} runs cached")]

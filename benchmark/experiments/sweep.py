@@ -348,7 +348,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                 results.update({(size, camera.name, condition): r for size, r in cached.items()})
                 done += n_scenes
         reused = {(camera_name, condition) for size, camera_name, condition in results}
-        if progress and reused:  # at once: the log's estimate of the time left counts the runs done after it
+        if progress:  # before any unit: a log estimates the time left from what is done after this count
             progress(done, total, f"{len(reused)} runs cached")
 
         in_process = runs_in_process(workers, scheduler)
