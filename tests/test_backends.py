@@ -328,8 +328,10 @@ def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(seria
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(run_module._CameraRun, "add", add)
-        run_module.run_camera(collection, camera, "day", detector, out)
+        counts = []
+        run_module.run_camera(collection, camera, "day", detector, out, progress=lambda d, t: counts.append(d))
     assert len(simulated) == len(collection.scenes()) - 2
+    assert counts == list(range(2, len(collection.scenes()) + 1))  # the two found done at once, then each made
     assert _sweep_files(out) == _sweep_files(tmp_path / "wholerun") and not stage.exists()
 
     # With a pass's run beside it: its stage lost, the camera's scenes are all made again.

@@ -497,6 +497,9 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
     another, so the scene's last resample serves them all."""
     order = sorted(range(len(runs)), key=lambda k: (str(grid_key(runs[k].camera)), k))
     scenes = collection.scenes()
+    found = [all(scene.scene_id in run.done for run in runs) for scene in scenes]  # a resumed run's
+    if progress:  # those first, at once: a log estimates the time left from the scenes made after them
+        progress(sum(found), len(scenes))
     for i, scene in enumerate(scenes):
         record = collection.condition_record(scene.scene_id, condition)  # a targeted condition's weights, once
         radiance, read_s = None, 0.0
@@ -506,7 +509,7 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
             read_s = time.perf_counter() - t
         for k in order:
             runs[k].add(scene, radiance, read_s, record)
-        if progress:
+        if progress and not found[i]:
             progress(i + 1, len(scenes))
     return [run.finish() for run in runs]
 
