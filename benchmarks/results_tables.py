@@ -4,6 +4,7 @@
     PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data
     PYTHONPATH=. python benchmarks/results_tables.py publish --results results --collection metric-300 \
         --out docs/data/metric-300
+    PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data/metric-300 --against docs/data
 
 ``publish`` copies each sweep's ``sweep.csv`` and ``od50.csv`` (folders ``COLLECTION``,
 ``COLLECTION-640``, ``-native``, ``-lux``, ``-day-paper``, ``-policy-…``; default ``quick``) into
@@ -12,7 +13,8 @@
 policy's rows coming from the reference sweep). ``markdown`` prints the tables of
 docs/results.md from those files: AP per distance with Spearman's ρ and OD50 per condition,
 the input-size comparison, the acquisition policies and the illuminance sweep (those a
-folder holds: metric-300 has no native or policy sweeps).
+folder holds: metric-300 has no native or policy sweeps); with ``--against`` another collection's
+folder, each condition's OD50s camera by camera in both, with SDs and ranks (metric-300 against quick).
 """
 
 from __future__ import annotations
@@ -202,7 +204,47 @@ def night_factors_table(data: Path) -> str:
     return "\n".join(lines)
 
 
-def markdown(data: Path) -> str:
+def rank_value(row, ap: pd.Series) -> float:
+    """An OD50 to rank by: measured as it is; censored beyond every measured one ("> 200" above,
+    "< 25" below), ordered among themselves by their AP at that bound (``ap``: by distance)."""
+    if row["censored"] == ">":
+        return 1e9 + ap[ap.index.max()]
+    if row["censored"] == "<":
+        return -1e9 + ap[ap.index.min()]
+    return float(row["od50_m"])
+
+
+def collections_table(data: Path, other: Path, names: tuple[str, str], condition: str) -> str:
+    """One condition's OD50s in this folder's collection against another's (metric-300 against
+    quick): each with its bootstrap SD, the SD ratio and the difference in units of the two SDs
+    combined where both are measured (different scenes: unpaired), each camera's rank in each;
+    then Spearman's ρ of the two orders."""
+    from scipy import stats
+
+    loaded = [_load(folder, "") for folder in (other, data)]
+    tables = [od50[od50["condition"] == condition].set_index("camera") for _, od50 in loaded]
+    cameras = [c for c in tables[0].index if c in tables[1].index]  # (ranked among the cameras both hold)
+    sides = []
+    for (table, _), od50 in zip(loaded, tables):
+        ap = table[table["condition"] == condition].set_index(["camera", "distance_m"])["ap"]
+        value = pd.Series({camera: rank_value(od50.loc[camera], ap[camera]) for camera in cameras})
+        sides.append((od50, value.rank(ascending=False, method="min").astype(int)))
+    (a, rank_a), (b, rank_b) = sides
+    lines = [_row(["camera", "MTF50", f"OD50 {names[0]} (m)", f"OD50 {names[1]} (m)", "SD ratio", "difference / SD",
+                   f"rank {names[0]} → {names[1]}"]), _rule(7)]
+    for camera in sorted(cameras, key=lambda c: rank_b[c]):
+        ra, rb = a.loc[camera], b.loc[camera]
+        measured = not ra["censored"] and not rb["censored"]
+        both = np.hypot(ra["sd_m"], rb["sd_m"])
+        lines.append(_row([camera, f"{rb['mtf50_cy_per_mm']:.1f}", _od50_metres(ra), _od50_metres(rb),
+                           f"{rb['sd_m'] / ra['sd_m']:.2f}" if measured and ra["sd_m"] > 0 else "—",
+                           _minus(f"{(rb['od50_m'] - ra['od50_m']) / both:.1f}") if measured and both > 0 else "—",
+                           f"{rank_a[camera]} → {rank_b[camera]}"]))
+    rho = stats.spearmanr(rank_a[cameras], rank_b[cameras]).statistic
+    return "\n".join(lines) + f"\n\nSpearman's ρ of the two orders ({len(cameras)} cameras): {_minus(f'{rho:.2f}')}"
+
+
+def markdown(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> str:
     table, od50 = _load(data, "")
     parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])]
     if set(NIGHTS) <= set(table["condition"]):
@@ -217,6 +259,11 @@ def markdown(data: Path) -> str:
         parts.append(f"### day_paper\n\n{day_paper_table(data)}")
     if (data / "night-factors.csv").exists():
         parts.append(f"### night factors\n\n{night_factors_table(data)}")
+    if against is not None:
+        shared = [c for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])
+                  and c in set(pd.read_csv(against / "od50.csv")["condition"])]
+        parts += [f"### {c}: {names[1]} against {names[0]}\n\n{collections_table(data, against, names, c)}"
+                  for c in shared]
     return "\n\n".join(parts)
 
 
@@ -229,11 +276,13 @@ def main() -> None:
     p.add_argument("--out", type=Path, default=Path("docs/data"))
     m = sub.add_parser("markdown", help="print docs/results.md's tables")
     m.add_argument("--data", type=Path, default=Path("docs/data"))
+    m.add_argument("--against", type=Path, help="another collection's tables (docs/data: quick's), camera by camera")
+    m.add_argument("--names", default="quick,metric-300", help="the --against collection's name, then --data's")
     args = parser.parse_args()
     if args.command == "publish":
         publish(args.results, args.out, args.collection)
     else:
-        print(markdown(args.data))
+        print(markdown(args.data, args.against, tuple(args.names.split(","))))
 
 
 if __name__ == "__main__":

@@ -69,3 +69,23 @@ def test_markdown_of_a_folder_without_native_or_policy_sweeps(load_benchmark, tm
     page = results_tables.markdown(tmp_path)
     assert "### day" in page and "### illuminance" in page
     assert "### policies" not in page and "### input size" not in page
+
+
+def test_one_collection_against_another_camera_by_camera(load_benchmark, tmp_path):
+    """metric-300 against quick (here quick against an edited copy of itself): OD50s, SD ratio,
+    difference in combined SDs and ranks among the cameras both hold, and the orders' ρ."""
+    results_tables = load_benchmark("results_tables")
+    sweep, od50 = (pd.read_csv(DATA / f"{name}.csv") for name in ("sweep", "od50"))
+    od50.loc[(od50["condition"] == "day") & (od50["camera"] == "cam05"), "sd_m"] *= 2
+    od50[od50["camera"] != "cam13"].to_csv(tmp_path / "od50.csv", index=False)
+    sweep[sweep["camera"] != "cam13"].to_csv(tmp_path / "sweep.csv", index=False)
+    page = results_tables.markdown(tmp_path, DATA, ("quick", "other"))
+    day = page.split("### day: other against quick")[1].split("###")[0]
+    rows = {cells[0]: cells for cells in ([c.strip() for c in line.strip("|").split("|")]
+                                          for line in day.splitlines() if line.startswith("| cam")) if cells[0] != "camera"}
+    assert len(rows) == 12 and "cam13" not in rows
+    assert rows["cam05"][4:6] == ["2.00", "0.0"] and rows["cam01"][4:6] == ["1.00", "0.0"]
+    assert rows["cam12"][4:6] == ["—", "—"]  # > 200 m by day: censored, not compared
+    assert all(len(set(cells[6].split(" → "))) == 1 for cells in rows.values())  # the same order
+    assert "Spearman's ρ of the two orders (12 cameras): 1.00" in day
+    assert "### night: other against quick" in page and "### night_regulation: other against quick" in page
