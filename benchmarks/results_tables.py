@@ -214,14 +214,13 @@ def rank_value(row, ap: pd.Series) -> float:
     return float(row["od50_m"])
 
 
-def collections_table(data: Path, other: Path, names: tuple[str, str], condition: str) -> str:
+def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tuple[str, str], condition: str) -> str:
     """One condition's OD50s in this folder's collection against another's (metric-300 against
     quick): each with its bootstrap SD, the SD ratio and the difference in units of the two SDs
     combined where both are measured (different scenes: unpaired), each camera's rank in each;
-    then Spearman's ρ of the two orders."""
+    then Spearman's ρ of the two orders. ``loaded``: :func:`_load` of the other folder, then this one."""
     from scipy import stats
 
-    loaded = [_load(folder, "") for folder in (other, data)]
     tables = [od50[od50["condition"] == condition].set_index("camera") for _, od50 in loaded]
     cameras = [c for c in tables[0].index if c in tables[1].index]  # (ranked among the cameras both hold)
     sides = []
@@ -260,10 +259,9 @@ def markdown(data: Path, against: Path | None = None, names: tuple[str, str] = (
     if (data / "night-factors.csv").exists():
         parts.append(f"### night factors\n\n{night_factors_table(data)}")
     if against is not None:
-        shared = [c for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])
-                  and c in set(pd.read_csv(against / "od50.csv")["condition"])]
-        parts += [f"### {c}: {names[1]} against {names[0]}\n\n{collections_table(data, against, names, c)}"
-                  for c in shared]
+        loaded = [_load(against, ""), (table, od50)]
+        shared = [c for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"]) and c in set(loaded[0][0]["condition"])]
+        parts += [f"### {c}: {names[1]} against {names[0]}\n\n{collections_table(loaded, names, c)}" for c in shared]
     return "\n\n".join(parts)
 
 
