@@ -27,6 +27,7 @@ import pandas as pd
 
 from benchmark.experiments.acceptance import ap_distance_rho
 from benchmark.experiments.sweep import od50_cell, with_censoring
+from benchmark.scoring.od50 import od50_rank_value
 
 REFERENCE_POLICY = "auto_peak (reference)"
 POLICIES = {"percentile:99": "-policy-percentile-99", "mean_level@0.18": "-policy-mean_level-0.18",
@@ -205,13 +206,11 @@ def night_factors_table(data: Path) -> str:
 
 
 def rank_value(row, ap: pd.Series) -> float:
-    """An OD50 to rank by: measured as it is; censored beyond every measured one ("> 200" above,
-    "< 25" below), ordered among themselves by their AP at that bound (``ap``: by distance)."""
-    if row["censored"] == ">":
-        return 1e9 + ap[ap.index.max()]
-    if row["censored"] == "<":
-        return -1e9 + ap[ap.index.min()]
-    return float(row["od50_m"])
+    """A table row's OD50 to rank by, by the leaderboard's rule
+    (:func:`benchmark.scoring.od50.od50_rank_value`; ``ap``: the camera's AP by distance)."""
+    censored = row["censored"] if isinstance(row["censored"], str) else ""
+    bound = {">": ap.index.max(), "<": ap.index.min()}.get(censored)
+    return od50_rank_value(row["od50_m"], censored, bound, None if bound is None else ap[bound])
 
 
 def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tuple[str, str], condition: str) -> str:

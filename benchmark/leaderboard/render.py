@@ -80,24 +80,14 @@ def censoring(cond: dict) -> tuple[str, float | None, float | None]:
 
 
 def od50_sort_value(cond: dict | None) -> float | None:
-    """The number a condition is ranked by (higher is better; None: absent).
+    """The number a condition is ranked by (higher is better; None: absent):
+    :func:`benchmark.scoring.od50.od50_rank_value` of its OD50, censored from its per-distance AP."""
+    from benchmark.scoring.od50 import od50_rank_value
 
-    The rank rule (docs/leaderboard.md): a measured OD50 ranks by its value. "> D_far" (AP
-    has not fallen to 0.5 at the farthest distance) ranks above every measured value (a
-    measured OD50 is at most D_far); ties among them are broken by AP at D_far (value
-    D_far + AP, in [D_far + 0.5, D_far + 1]). "< D_near" (AP below 0.5 at the nearest
-    distance) ranks below every measured value (value D_near × AP at D_near, below D_near / 2),
-    so one that nearly reaches AP 0.5 ranks above one that sees nothing. An extrapolated
-    OD50 is never the key.
-    """
     if cond is None:
         return None
     censored, bound, at = censoring(cond)
-    if censored == ">":
-        return math.inf if bound is None else bound + at
-    if censored == "<":
-        return bound * at
-    return float(cond["od50_m"])
+    return od50_rank_value(cond["od50_m"], censored, bound, at)
 
 
 def rank_key(sub: dict) -> tuple:

@@ -29,6 +29,8 @@ nearest: an upper bound). See :func:`format_od50`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 AP_LEVEL = 0.5
@@ -92,6 +94,22 @@ def od50_censoring(distances_m, ap, *, level: float = AP_LEVEL) -> tuple[str, fl
     if a[-1] >= level:
         return CENSORED_ABOVE, float(d[-1])
     return CENSORED_BELOW, float(d[0])
+
+
+def od50_rank_value(od50_m, censored: str = "", bound_m: float | None = None, ap_at_bound: float | None = None) -> float:
+    """The number an OD50 is ranked by, higher better (docs/leaderboard.md, "Censored OD50 and the rank rule").
+
+    A measured OD50 ranks by its value. ``">"`` ranks above every measured one (a measured OD50
+    is at most the farthest distance): ``bound_m + ap_at_bound``, in [D_far + 0.5, D_far + 1],
+    so ties among them break by AP there (infinite with no bound). ``"<"`` ranks below every
+    measured one: ``bound_m × ap_at_bound``, below D_near / 2, so one that nearly reaches AP 0.5
+    ranks above one that sees nothing. An extrapolated OD50 is never the key.
+    """
+    if censored == CENSORED_ABOVE:
+        return math.inf if bound_m is None else float(bound_m) + float(ap_at_bound)
+    if censored == CENSORED_BELOW:
+        return float(bound_m) * float(ap_at_bound)
+    return float(od50_m)
 
 
 def format_od50(od50_m, censored: str = "", bound_m: float | None = None, sd_m=None, *, unit: str = " m") -> str:
