@@ -206,11 +206,10 @@ def night_factors_table(data: Path) -> str:
 
 
 def rank_value(row, ap: pd.Series) -> float:
-    """A table row's OD50 to rank by, by the leaderboard's rule
-    (:func:`benchmark.scoring.od50.od50_rank_value`; ``ap``: the camera's AP by distance)."""
-    censored = row["censored"] if isinstance(row["censored"], str) else ""
-    bound = {">": ap.index.max(), "<": ap.index.min()}.get(censored)
-    return od50_rank_value(row["od50_m"], censored, bound, None if bound is None else ap[bound])
+    """A row of :func:`_load`'s od50 table (its ``censored`` and ``bound_m``) to rank by, by the
+    leaderboard's rule (:func:`benchmark.scoring.od50.od50_rank_value`; ``ap``: the camera's AP by distance)."""
+    bound = float(row["bound_m"]) if row["censored"] else None
+    return od50_rank_value(row["od50_m"], row["censored"], bound, None if bound is None else ap[bound])
 
 
 def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tuple[str, str], condition: str) -> str:
