@@ -424,9 +424,13 @@ class Collection:
     def illuminance_lux(self, scene_id: str, condition: str | dict[str, float]) -> float:
         """Horizontal illuminance at the camera (lux) under a condition: the light groups'
         measured values, weighted (car lamps not included: they face the road)."""
+        return self._illuminance_under(scene_id, self._weights(condition, scene_id))
+
+    def _illuminance_under(self, scene_id: str, weights: dict[str, float]) -> float:
+        """:meth:`illuminance_lux` for weights already resolved."""
         env = self._image(scene_id)["environment_id"]
         measured = self.resolved.illuminance_lux[f"env{env:03d}"]
-        return float(sum(w * measured.get(g, 0.0) for g, w in self._weights(condition, scene_id).items()))
+        return float(sum(w * measured.get(g, 0.0) for g, w in weights.items()))
 
     def mean_luminance(self, scene_id: str, condition: str | dict[str, float]) -> float:
         """Mean luminance (cd/m²) of a scene under a condition over the field of view, on the
@@ -493,18 +497,19 @@ class Collection:
         all its conditions (a targeted condition's weights need them anyway)."""
         from metricscenes.photometry import image_plane_illuminance_lux
 
-        weights = self._weights(condition, scene_id)
+        targeted = (self.targeted_weights(scene_id, condition)
+                    if isinstance(condition, str) and self.is_targeted(condition) else None)
+        weights = targeted.weights if targeted is not None else self._weights(condition, scene_id)
         luminance = float(sum(w * self.group_luminance(scene_id, g) for g, w in weights.items() if w != 0.0))
         out = {
             "scene_id": scene_id, "condition": condition if isinstance(condition, str) else dict(condition),
-            "illuminance_at_camera_lux": self.illuminance_lux(scene_id, condition),
+            "illuminance_at_camera_lux": self._illuminance_under(scene_id, weights),
             "mean_luminance_cd_m2": luminance,
             "f_number": f_number,
             "image_plane_illuminance_lux": image_plane_illuminance_lux(luminance, f_number),
         }
-        targeted = self.condition_record(scene_id, condition)
         if targeted is not None:
-            out["targeted"] = targeted
+            out["targeted"] = targeted.record()
         return out
 
     def _image(self, scene_id: str) -> dict:
