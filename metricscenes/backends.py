@@ -139,8 +139,12 @@ def _dask_client(scheduler: str, workers: int):
                                        dashboard_address=None, silence_logs=logging.ERROR)
         except (RuntimeError, OSError) as exc:
             raise BackendError(f"--scheduler local: dask could not start {workers} workers ({_one_line(exc)})") from None
-        with cluster, Client(cluster, set_as_default=False) as client:
-            yield client
+        try:
+            with cluster, Client(cluster, set_as_default=False) as client:
+                yield client
+        except TimeoutError as exc:  # an OSError: the CLI would call it "cannot write" the output
+            raise BackendError(f"--scheduler local: dask timed out ({_one_line(exc)}); the units it finished "
+                               "are kept: run the same command again to resume") from None
         return
     try:
         client = Client(scheduler, timeout=CONNECT_TIMEOUT_S, set_as_default=False)

@@ -376,6 +376,29 @@ def test_missing_dask_is_one_line(monkeypatch):
         check_scheduler("local")
 
 
+def test_a_local_cluster_that_times_out_is_one_line_not_an_unwritable_output(monkeypatch):
+    # a loaded machine: dask's LocalCluster timed out closing after every unit was written, and
+    # the CLI reported the TimeoutError (an OSError) as "cannot write <out>"
+    import distributed
+
+    class SlowToClose:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            raise TimeoutError("cluster did not close in 30 s")
+
+    monkeypatch.setattr(distributed, "LocalCluster", SlowToClose)
+    monkeypatch.setattr(distributed, "Client", SlowToClose)
+    with pytest.raises(BackendError, match="local: dask timed out .*run the same command again") as refused:
+        with backends._dask_client("local", 2):
+            pass
+    assert "\n" not in str(refused.value)
+
+
 def _closed_port() -> int:
     import socket
 
