@@ -139,20 +139,27 @@ def _dask_client(scheduler: str, workers: int):
                                        dashboard_address=None, silence_logs=logging.ERROR)
         except (RuntimeError, OSError) as exc:
             raise BackendError(f"--scheduler local: dask could not start {workers} workers ({_one_line(exc)})") from None
-        try:
-            with cluster, Client(cluster, set_as_default=False) as client:
-                yield client
-        except TimeoutError as exc:  # an OSError: the CLI would call it "cannot write" the output
-            raise BackendError(f"--scheduler local: dask timed out ({_one_line(exc)}); the units it finished "
-                               "are kept: run the same command again to resume") from None
+        with _timeout_as_backend_error(scheduler), cluster, Client(cluster, set_as_default=False) as client:
+            yield client
         return
     try:
         client = Client(scheduler, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError) as exc:
         raise BackendError(f"--scheduler {scheduler}: no dask scheduler answers there ({_one_line(exc)}); "
                            "start one (dask scheduler) or use --scheduler local") from None
-    with client:
+    with _timeout_as_backend_error(scheduler), client:
         yield client
+
+
+@contextmanager
+def _timeout_as_backend_error(scheduler: str):
+    """A dask timeout (a TimeoutError is an OSError: the CLI would call it "cannot write" the
+    output) as one line that says what timed out and that finished units are kept."""
+    try:
+        yield
+    except TimeoutError as exc:
+        raise BackendError(f"--scheduler {scheduler}: dask timed out ({_one_line(exc)}); the units it finished "
+                           "are kept: run the same command again to resume") from None
 
 
 def _one_line(exc: BaseException) -> str:
