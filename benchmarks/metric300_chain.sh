@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# metric-300 from nothing to its published tables, one resumable step after another:
+# generate, verify, the reference sweep (13 cameras x day, dusk and both nights, with its
+# 640 and native passes from the same inference), the illuminance sweep, the MTF50 groups'
+# pairs, docs/data/metric-300's tables, the report and the 13 reference submissions, then
+# day_paper. Each step skips what is done (generate and sweep resume unit by unit and scene
+# by scene; verify leaves a marker), so after a killed session run the same command again.
+# Long: about 11.5 h of generation and 4-5 h of sweep on 2 AVX2 cores (docs/performance.md).
+#
+#   nohup setsid bash benchmarks/metric300_chain.sh /work/m300 >> /work/m300-chain.log 2>&1 &
+#
+# WORK (the first argument) holds the collection, the sweep folders and the markers, outside
+# git. Run it from a checkout nobody commits to while it runs (a `git worktree` of a landed
+# commit): a sweep must not mix two versions of the code. Writes nothing into this checkout
+# but docs/data/metric-300 (the published tables); the report and the submissions go under WORK.
+set -euo pipefail
+WORK=$(realpath -m "${1:?usage: metric300_chain.sh WORK}")
+cd "$(dirname "$0")/.."
+export PYTHONPATH=$PWD  # this checkout's code, even where the venv's editable install points at another
+export METRICSCENES_MODEL_DIR=$(realpath "${METRICSCENES_MODEL_DIR:-../shared/models}")
+export MPLBACKEND=Agg PYTHONUNBUFFERED=1
+COLLECTION=$WORK/collections/metric-300
+RESULTS=$WORK/results
+mkdir -p "$RESULTS"
+SWEEP=(--no-save-images --resamples 1000 --seed 0 --workers 2)
+timed() { local t0; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $1 $2 (this sitting): $(( $(date +%s) - t0 )) s wall"; }
+
+timed metricscenes generate --manifest manifests/metric-300.yaml --out "$COLLECTION" --workers 1
+if [ ! -e "$WORK/verified" ]; then
+  timed metricscenes verify "$COLLECTION"
+  touch "$WORK/verified"
+fi
+timed benchmark sweep --collection "$COLLECTION" --cameras all --conditions day,dusk,night,night_regulation \
+  --out "$RESULTS/metric-300" --also-input-size 640="$RESULTS/metric-300-640" \
+  --also-input-size native="$RESULTS/metric-300-native" "${SWEEP[@]}"
+timed benchmark sweep --collection "$COLLECTION" --cameras cameras/lux-sweep-1.4um-f2.4.yaml \
+  --conditions day@0.25lux,day@1lux,day@5lux,day@10lux,day@50lux,day@100lux,day@500lux \
+  --out "$RESULTS/metric-300-lux" "${SWEEP[@]}"
+PYTHONPATH=. python benchmarks/mtf50_groups.py --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
+  --out docs/data/metric-300/mtf50-groups.csv
+PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+  --out docs/data/metric-300
+benchmark report "$RESULTS/metric-300" "$RESULTS/metric-300-lux" --out "$WORK/reports/metric-300.html"
+# The 13 reference submissions, into a leaderboard folder of WORK's (copied to leaderboard/ by hand).
+mkdir -p "$WORK/leaderboard/submissions"
+for camera in $(seq -f "cam%02g" 1 13); do
+  [ -e "$WORK/leaderboard/submissions/ref-$camera-yolov5n-metric-300.json" ] \
+    || benchmark submit "$RESULTS/metric-300" --camera "$camera" --name "ref-{camera}-yolov5n-metric-300" \
+         --submitter "metricscenes reference" --leaderboard "$WORK/leaderboard"
+  benchmark submit --check "$WORK/leaderboard/submissions/ref-$camera-yolov5n-metric-300.json" --leaderboard "$WORK/leaderboard"
+done
+timed benchmark sweep --collection "$COLLECTION" --cameras all --conditions day_paper \
+  --out "$RESULTS/metric-300-day-paper" "${SWEEP[@]}"
+PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+  --out docs/data/metric-300
+echo "== $(date -u +%FT%TZ) metric-300 chain done"
