@@ -12,45 +12,54 @@
 # WORK (the first argument) holds the collection, the sweep folders and the markers, outside
 # git. Run it from a checkout nobody commits to while it runs (a `git worktree` of a landed
 # commit): a sweep must not mix two versions of the code. Writes nothing into this checkout
-# but docs/data/metric-300 (the published tables); the report and the submissions go under WORK.
+# but $DATA_OUT (docs/data/metric-300: the published tables); the report and the submissions
+# go under WORK. To try the chain on a small stand-in first: MANIFEST=<a shrunk copy of
+# metric-300.yaml> CAMERAS=cam12,cam01 DATA_OUT=<a folder outside git> (the submissions then
+# need WORK/leaderboard/protocols.yaml to accept the stand-in's manifest sha256).
 set -euo pipefail
 WORK=$(realpath -m "${1:?usage: metric300_chain.sh WORK}")
 cd "$(dirname "$0")/.."
 export PYTHONPATH=$PWD  # this checkout's code, even where the venv's editable install points at another
 export METRICSCENES_MODEL_DIR=$(realpath "${METRICSCENES_MODEL_DIR:-../shared/models}")
 export MPLBACKEND=Agg PYTHONUNBUFFERED=1
+MANIFEST=${MANIFEST:-manifests/metric-300.yaml}
+CAMERAS=${CAMERAS:-all}
+DATA_OUT=${DATA_OUT:-docs/data/metric-300}
 COLLECTION=$WORK/collections/metric-300
 RESULTS=$WORK/results
+mkdir -p "$DATA_OUT"
 mkdir -p "$RESULTS"
 SWEEP=(--no-save-images --resamples 1000 --seed 0 --workers 2)
-timed() { local t0; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $1 $2 (this sitting): $(( $(date +%s) - t0 )) s wall"; }
+# timed STEP COMMAND...: the command, then "== STEP (this sitting): N s wall" (a resumed step counts its sitting only)
+timed() { local step=$1 t0; shift; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $step (this sitting): $(( $(date +%s) - t0 )) s wall"; }
 
-timed metricscenes generate --manifest manifests/metric-300.yaml --out "$COLLECTION" --workers 1
+timed generate metricscenes generate --manifest "$MANIFEST" --out "$COLLECTION" --workers 1
 if [ ! -e "$WORK/verified" ]; then
-  timed metricscenes verify "$COLLECTION"
+  timed verify metricscenes verify "$COLLECTION"
   touch "$WORK/verified"
 fi
-timed benchmark sweep --collection "$COLLECTION" --cameras all --conditions day,dusk,night,night_regulation \
+timed sweep benchmark sweep --collection "$COLLECTION" --cameras "$CAMERAS" --conditions day,dusk,night,night_regulation \
   --out "$RESULTS/metric-300" --also-input-size 640="$RESULTS/metric-300-640" \
   --also-input-size native="$RESULTS/metric-300-native" "${SWEEP[@]}"
-timed benchmark sweep --collection "$COLLECTION" --cameras cameras/lux-sweep-1.4um-f2.4.yaml \
+timed lux-sweep benchmark sweep --collection "$COLLECTION" --cameras cameras/lux-sweep-1.4um-f2.4.yaml \
   --conditions day@0.25lux,day@1lux,day@5lux,day@10lux,day@50lux,day@100lux,day@500lux \
   --out "$RESULTS/metric-300-lux" "${SWEEP[@]}"
 PYTHONPATH=. python benchmarks/mtf50_groups.py --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
-  --out docs/data/metric-300/mtf50-groups.csv
+  --out "$DATA_OUT/mtf50-groups.csv"
 PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
-  --out docs/data/metric-300
+  --out "$DATA_OUT"
 benchmark report "$RESULTS/metric-300" "$RESULTS/metric-300-lux" --out "$WORK/reports/metric-300.html"
 # The 13 reference submissions, into a leaderboard folder of WORK's (copied to leaderboard/ by hand).
 mkdir -p "$WORK/leaderboard/submissions"
-for camera in $(seq -f "cam%02g" 1 13); do
+[ "$CAMERAS" = all ] && cameras=$(seq -f "cam%02g" 1 13) || cameras=${CAMERAS//,/ }
+for camera in $cameras; do
   [ -e "$WORK/leaderboard/submissions/ref-$camera-yolov5n-metric-300.json" ] \
     || benchmark submit "$RESULTS/metric-300" --camera "$camera" --name "ref-{camera}-yolov5n-metric-300" \
          --submitter "metricscenes reference" --leaderboard "$WORK/leaderboard"
   benchmark submit --check "$WORK/leaderboard/submissions/ref-$camera-yolov5n-metric-300.json" --leaderboard "$WORK/leaderboard"
 done
-timed benchmark sweep --collection "$COLLECTION" --cameras all --conditions day_paper \
+timed day-paper-sweep benchmark sweep --collection "$COLLECTION" --cameras "$CAMERAS" --conditions day_paper \
   --out "$RESULTS/metric-300-day-paper" "${SWEEP[@]}"
 PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
-  --out docs/data/metric-300
+  --out "$DATA_OUT"
 echo "== $(date -u +%FT%TZ) metric-300 chain done"
