@@ -27,8 +27,7 @@ CAMERAS=${CAMERAS:-all}
 DATA_OUT=${DATA_OUT:-docs/data/metric-300}
 COLLECTION=$WORK/collections/metric-300
 RESULTS=$WORK/results
-mkdir -p "$DATA_OUT"
-mkdir -p "$RESULTS"
+mkdir -p "$DATA_OUT" "$RESULTS"
 SWEEP=(--no-save-images --resamples 1000 --seed 0 --workers 2)
 # timed STEP COMMAND...: the command, then "== STEP (this sitting): N s wall" (a resumed step counts its sitting only)
 timed() { local step=$1 t0; shift; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $step (this sitting): $(( $(date +%s) - t0 )) s wall"; }
@@ -44,9 +43,9 @@ timed sweep benchmark sweep --collection "$COLLECTION" --cameras "$CAMERAS" --co
 timed lux-sweep benchmark sweep --collection "$COLLECTION" --cameras cameras/lux-sweep-1.4um-f2.4.yaml \
   --conditions day@0.25lux,day@1lux,day@5lux,day@10lux,day@50lux,day@100lux,day@500lux \
   --out "$RESULTS/metric-300-lux" "${SWEEP[@]}"
-PYTHONPATH=. python benchmarks/mtf50_groups.py --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
+python benchmarks/mtf50_groups.py --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
   --out "$DATA_OUT/mtf50-groups.csv"
-PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
   --out "$DATA_OUT"
 benchmark report "$RESULTS/metric-300" "$RESULTS/metric-300-lux" --out "$WORK/reports/metric-300.html"
 # The 13 reference submissions, into a leaderboard folder of WORK's (copied to leaderboard/ by hand).
@@ -60,6 +59,6 @@ for camera in $cameras; do
 done
 timed day-paper-sweep benchmark sweep --collection "$COLLECTION" --cameras "$CAMERAS" --conditions day_paper \
   --out "$RESULTS/metric-300-day-paper" "${SWEEP[@]}"
-PYTHONPATH=. python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
   --out "$DATA_OUT"
 echo "== $(date -u +%FT%TZ) metric-300 chain done"
