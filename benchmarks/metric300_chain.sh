@@ -16,6 +16,8 @@
 # go under WORK. To try the chain on a small stand-in first: MANIFEST=<a shrunk copy of
 # metric-300.yaml> CAMERAS=cam12,cam01 DATA_OUT=<a folder outside git> (the submissions then
 # need WORK/leaderboard/protocols.yaml to accept the stand-in's manifest sha256).
+# Then benchmarks/metric300_land.sh, from the checkout that commits, brings tables, figures
+# and submissions in and checks them.
 set -euo pipefail
 WORK=$(realpath -m "${1:?usage: metric300_chain.sh WORK}")
 cd "$(dirname "$0")/.."

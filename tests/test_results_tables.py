@@ -61,7 +61,8 @@ def test_publish_lays_sweep_folders_out_as_docs_data(load_benchmark, tmp_path, c
 
 
 def test_markdown_of_a_folder_without_native_or_policy_sweeps(load_benchmark, tmp_path):
-    """metric-300's folder (docs/data/metric-300) holds no native or policy sweeps."""
+    """A collection's folder without the native and policy sweeps (metric-300's has no policy
+    sweeps): their sections are left out, the others written."""
     results_tables = load_benchmark("results_tables")
     for suffix in ("", "-640", "-illuminance"):
         for name in ("sweep", "od50"):
