@@ -4,12 +4,13 @@
 # reference submissions (leaderboard/submissions), every submission `--check`ed, the
 # leaderboard rendered twice and compared byte for byte, the findings tests on the tables,
 # and the markdown of metric-300's tables beside quick's (WORK/results-markdown.md, for
-# docs/results.md). Copies only what exists; refuses to start before the chain is done.
+# docs/results.md). Refuses to start before the chain's tables are all there.
 #
 #   bash benchmarks/metric300_land.sh /work /work/m300-code/docs/data/metric-300
 #
 # WORK: the chain's WORK; TABLES: the chain's DATA_OUT (in the checkout the chain ran from).
-# LEADERBOARD (default leaderboard) and DATA (default docs/data/metric-300) let it run on a stand-in.
+# LEADERBOARD (default leaderboard), DATA (docs/data/metric-300) and IMG (docs/img/metric-300)
+# let it run on a stand-in (the findings tests then are not run).
 set -euo pipefail
 WORK=$(realpath "${1:?usage: metric300_land.sh WORK TABLES}")
 TABLES=$(realpath "${2:?usage: metric300_land.sh WORK TABLES}")
