@@ -2,10 +2,10 @@
 # What a sweep spends giving its large arrays back to the kernel: the same small sweep with
 # glibc's default (every block over 32 MB is mmap'ed and unmapped when freed, so each new
 # array is page-faulted in and zeroed by the kernel again) and with large blocks kept in the
-# heap for reuse (MALLOC_MMAP_MAX_=0, no trimming), alternated twice; prints user, system and
-# wall seconds, minor page faults and peak RSS of each, the ratio of their CPU times, and
-# whether the two settings' detections are byte-identical (they must be: only where the
-# memory comes from differs). Results: docs/performance.md, "Large arrays kept in the heap".
+# heap for reuse (benchmarks/heap-malloc.env, what metric300_chain.sh sweeps with), alternated
+# twice; prints user, system and wall seconds, minor page faults and peak RSS of each, the
+# ratio of their CPU times, and whether the two settings' detections are byte-identical
+# (they must be: only where the memory comes from differs). Results: docs/performance.md, "Large arrays kept in the heap".
 #
 #   bash benchmarks/bench_malloc.sh /work/collections/metric-300-first2 cam08,cam12,cam05 day
 set -euo pipefail
@@ -14,7 +14,7 @@ CAMERAS=${2:-cam08,cam12,cam05}
 CONDITION=${3:-day}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
-HEAP=(MALLOC_MMAP_MAX_=0 MALLOC_TRIM_THRESHOLD_=68719476736 MALLOC_TOP_PAD_=268435456)
+mapfile -t HEAP < <(grep -v '^#' "$(dirname "$0")/heap-malloc.env")  # the chain's setting
 for round in 1 2; do
   for setting in default heap; do
     rm -rf "$OUT/$setting"

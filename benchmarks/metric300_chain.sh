@@ -31,10 +31,8 @@ COLLECTION=$WORK/collections/metric-300
 RESULTS=$WORK/results
 mkdir -p "$DATA_OUT" "$RESULTS"
 SWEEP=(--no-save-images --resamples 1000 --seed 0 --workers 2)
-# The sweeps' large arrays stay in the heap for reuse instead of being unmapped when freed and
-# page-faulted in again, zeroed, by the kernel: the same bytes for less CPU time
-# (benchmarks/bench_malloc.sh; docs/performance.md, "Large arrays kept in the heap").
-SWEEP_MALLOC=(MALLOC_MMAP_MAX_=0 MALLOC_TRIM_THRESHOLD_=68719476736 MALLOC_TOP_PAD_=268435456)
+# The sweeps keep their large arrays in the heap (same bytes, less CPU time; the file says why).
+mapfile -t SWEEP_MALLOC < <(grep -v '^#' benchmarks/heap-malloc.env)
 # timed STEP COMMAND...: the command, then "== STEP (this sitting): N s wall" (a resumed step counts its sitting only)
 timed() { local step=$1 t0; shift; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $step (this sitting): $(( $(date +%s) - t0 )) s wall"; }
 
