@@ -56,7 +56,10 @@ def test_day_od50_rises_with_mtf50(reference):
     assert findings["od50_rises_with_mtf50"] and findings["od50_mtf50_rho"] >= 0.6
 
 
-def test_day_od50_bootstrap_sds_are_smaller_than_quicks_for_11_of_13_cameras(reference):
-    quick = pd.read_csv(DOCS_DATA / "od50.csv", keep_default_na=False, na_values=[""])
-    found = od50_sd_shrinks(reference[1], quick)
-    assert found["smaller"] >= 11, found
+def test_day_od50_bootstrap_sds_are_smaller_than_quicks_for_11_of_13_cameras(paper_parity):
+    """At paper parity, where every camera's day OD50 lies inside the measured distances on
+    quick: with the reference input five of quick's 13 are censored ("> 200 m"), their SD the
+    edge of the distances rather than a spread, so 11 of 13 could not be compared there."""
+    quick = pd.read_csv(DOCS_DATA / "od50-640.csv", keep_default_na=False, na_values=[""])
+    found = od50_sd_shrinks(paper_parity[1], quick)
+    assert found["compared"] >= 11 and found["smaller"] >= 11, found
