@@ -62,4 +62,4 @@ def test_day_od50_bootstrap_sds_are_smaller_than_quicks_for_11_of_13_cameras(pap
     edge of the distances rather than a spread, so 11 of 13 could not be compared there."""
     quick = pd.read_csv(DOCS_DATA / "od50-640.csv", keep_default_na=False, na_values=[""])
     found = od50_sd_shrinks(paper_parity[1], quick)
-    assert found["compared"] >= 11 and found["smaller"] >= 11, found
+    assert found["smaller"] >= 11, found  # (counted among the compared cameras only)
