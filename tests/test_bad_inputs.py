@@ -6,7 +6,6 @@ and a detector whose outputs are NaN."""
 import hashlib
 import json
 import os
-import re
 import shutil
 import socket
 import subprocess
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
+from cli_output import error_lines
 from conftest import REPO, SMOKE_MANIFEST
 
 # A one-scene manifest: should a refusal fail to happen, the render is still short.
@@ -28,14 +28,10 @@ def _run(module, *args, env=None, timeout=300):
                           cwd=REPO, timeout=timeout, env={**os.environ, **(env or {})})
 
 
-PROGRESS_LINE = re.compile(r": \d+/\d+ \(\d+ %\), \d+ (min|h) ")
-
-
 def _one_line_error(proc) -> str:
     assert proc.returncode != 0, proc.stdout + proc.stderr
     assert "Traceback" not in proc.stderr + proc.stdout
-    # (off a terminal, progress comes as plain lines before the error: metricscenes.cli_support.LogProgress)
-    lines = [line for line in proc.stderr.splitlines() if line.strip() and not PROGRESS_LINE.search(line)]
+    lines = error_lines(proc.stderr)  # (progress lines may come first: cli_output)
     assert len(lines) == 1, proc.stderr
     assert lines[0].startswith("error: ")
     return lines[0]

@@ -6,6 +6,7 @@ import sys
 
 import pytest
 
+from cli_output import error_lines
 from conftest import REPO, SMOKE_MANIFEST
 
 
@@ -17,7 +18,7 @@ def _run(module, *args):
 def _one_line_error(proc):
     assert proc.returncode != 0
     assert "Traceback" not in proc.stderr + proc.stdout
-    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    lines = error_lines(proc.stderr)
     assert len(lines) == 1, proc.stderr
     return lines[0]
 

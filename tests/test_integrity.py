@@ -2,7 +2,6 @@
 repaired by rerunning `generate`; benchmark never writes into a collection."""
 
 import json
-import re
 import shutil
 import subprocess
 import sys
@@ -11,11 +10,11 @@ from pathlib import Path
 import pytest
 import yaml
 
+from cli_output import error_lines
 from metricscenes.store import Collection, CollectionError
 
 pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[1]
-PROGRESS_LINE = re.compile(r".+: \d+/\d+ \(\d+ %\), .+ elapsed(, about .+ left)?")  # cli_support.LogProgress
 
 
 def _copy(smoke_collection, tmp_path, name="copy") -> Path:
@@ -197,7 +196,7 @@ def test_cli_out_inside_a_collection_is_one_line(smoke_collection, command):
                            "--out", str(smoke_collection / "results"), *extra],
                           capture_output=True, text=True, cwd=REPO, timeout=300)
     assert proc.returncode != 0 and "Traceback" not in proc.stdout + proc.stderr
-    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    lines = error_lines(proc.stderr)
     assert len(lines) == 1 and "read-only" in lines[0], proc.stderr
     assert not (smoke_collection / "results").exists()
 
@@ -346,7 +345,7 @@ def test_verify_lists_edited_attributes_and_generate_repairs_them(smoke_collecti
                           text=True, cwd=REPO, timeout=300)
     assert proc.returncode == 1 and "Traceback" not in proc.stdout + proc.stderr
     assert len([line for line in proc.stdout.splitlines() if line.startswith("bad: ")]) == len(ATTRIBUTE_EDITS)
-    assert [line for line in proc.stderr.splitlines() if line.strip()] == [
+    assert error_lines(proc.stderr) == [
         f"error: {root}: {len(ATTRIBUTE_EDITS)} problem(s); rerun `metricscenes generate` with its manifest to repair it"]
     assert {str(p.relative_to(root)): p.read_bytes() for p in root.rglob("*") if p.is_file()} == before
     notices = []
@@ -372,8 +371,7 @@ def test_benchmark_run_refuses_a_moved_car_in_one_line_and_writes_nothing(smoke_
     proc = subprocess.run([sys.executable, "-m", "benchmark.cli.main", "run", "--camera", "cam12", "--collection",
                            str(root), "--out", str(out)], capture_output=True, text=True, cwd=REPO, timeout=300)
     assert proc.returncode == 2 and "Traceback" not in proc.stdout + proc.stderr
-    # (a loaded machine can take 30 s to reach the first scene: the progress line is not the error)
-    lines = [line for line in proc.stderr.splitlines() if line.strip() and not PROGRESS_LINE.fullmatch(line)]
+    lines = error_lines(proc.stderr)  # (a loaded machine can take 30 s to reach the first scene)
     assert len(lines) == 1 and "scene env000-d025m: insets/env000-d025m/" in lines[0], proc.stderr
     assert "attributes do not match their sha256" in lines[0]
     assert not out.exists()

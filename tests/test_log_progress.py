@@ -7,6 +7,7 @@ import io
 
 from rich.console import Console
 
+from cli_output import PROGRESS_LINE, error_lines
 from metricscenes.cli_support import LogProgress, progress_bar
 
 
@@ -61,3 +62,24 @@ def test_progress_bar_is_plain_lines_off_a_terminal_and_rich_on_one():
         assert not isinstance(bar, LogProgress)
     with progress_bar(Console(file=io.StringIO()), disable=True) as bar:  # --json: nothing at all
         assert not isinstance(bar, LogProgress)
+
+
+def test_the_tests_pattern_knows_every_progress_line_and_no_error():
+    """tests/cli_output.PROGRESS_LINE, which the one-line-error tests skip, is LogProgress's
+    line in all its forms (no total; a total with and without an estimate; minutes, hours)."""
+    out = io.StringIO()
+    now = [0.0]
+    progress = LogProgress(Console(file=out, width=300), step=0.0, clock=lambda: now[0])
+    counted = progress.add_task("sweep", total=None)
+    for done in range(1, 4):
+        now[0] += 2000.0
+        progress.update(counted, completed=done)
+    task = progress.add_task("rendering env000-d025m", total=None)
+    for done in range(0, 351, 50):
+        now[0] += 700.0
+        progress.update(task, completed=done, total=350)
+    lines = _lines(out)
+    assert {"done," in line for line in lines} == {True, False} and any(" h " in line for line in lines)
+    assert all(PROGRESS_LINE.fullmatch(line) for line in lines), lines
+    assert error_lines("\n".join([*lines, "error: sweep: 3/4 (75 %), 0 min 02 s elapsed", ""])) == [
+        "error: sweep: 3/4 (75 %), 0 min 02 s elapsed"]

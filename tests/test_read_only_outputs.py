@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from cli_output import error_lines
 from conftest import REPO, require_model
 
 BENCHMARK, METRICSCENES = "benchmark", "metricscenes"
@@ -241,7 +242,7 @@ def test_two_runs_on_one_out_and_a_killed_runs_stage(smoke_collection, tmp_path,
         second = subprocess.run(command, cwd=REPO, capture_output=True, text=True, timeout=300)
         assert first.poll() is None, "the first run ended before the second was refused"
         assert second.returncode == 2 and "Traceback" not in second.stderr
-        lines = [line for line in second.stderr.splitlines() if line.strip()]
+        lines = error_lines(second.stderr)
         assert len(lines) == 1, second.stderr
         assert f"another `benchmark run` is writing this run folder (PID {first.pid}" in lines[0], lines[0]
     finally:
