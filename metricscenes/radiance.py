@@ -333,11 +333,23 @@ def _linear_matrix(src0: float, src1: float, n_src: int, dst0: float, dst1: floa
     )
 
 
+BAND_PLANES_BLOCK_BYTES = 1 << 20  # a block of source rows that stays in cache while it is spread over the planes
+
+
 def band_planes(cube: np.ndarray) -> np.ndarray:
     """A (rows, cols, bands) cube as C-contiguous float32 band planes (bands, rows, cols): a
     view when the cube is stored band by band (as :meth:`SpectralScene.resample` returns
-    it), else one copy."""
-    return np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
+    it), else one copy, made a few rows at a time: numpy's copy of the whole transposed view
+    strides through memory and took 3x as long for a 1920 x 1080 x 31 plate (the values are
+    the same: a copy, or numpy's float32 cast)."""
+    planes = np.moveaxis(np.asarray(cube), 2, 0)
+    if planes.dtype == np.float32 and planes.flags.c_contiguous:
+        return planes
+    out = np.empty(planes.shape, np.float32)
+    step = max(1, BAND_PLANES_BLOCK_BYTES // max(1, planes.shape[0] * planes.shape[2] * planes.itemsize))
+    for r in range(0, planes.shape[1], step):
+        out[:, r : r + step] = planes[:, r : r + step]
+    return out
 
 
 def _apply(wy: sp.csr_matrix, wx: sp.csr_matrix, planes: np.ndarray) -> np.ndarray:

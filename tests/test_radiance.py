@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, pixels_to_tan, tan_to_pixels, world_to_tan
+from metricscenes import radiance
 from metricscenes.radiance import RadianceLayer, SpectralScene, feather_weights
 
 
@@ -107,3 +108,17 @@ def test_feather_leaves_edges_on_the_plate_border_hard():
     wy, wx = feather_weights(inset, REFERENCE_EXTENT)
     assert wx[0] == 1.0 and wx[-1] == pytest.approx(0.125)  # left edge on the border; right inside (4 px ramp)
     assert wy[0] == pytest.approx(0.25) and wy[-1] == 1.0  # top inside (2 px ramp); bottom on the border
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_band_planes_are_the_transposed_cube_in_blocks_of_rows(dtype, monkeypatch):
+    """The blocked copy gives numpy's whole-view copy's values, whatever the block (one row,
+    a block that does not divide the rows, all of them), and a band-major cube is not copied."""
+    cube = np.random.default_rng(1).random((37, 23, 31)).astype(dtype)
+    want = np.ascontiguousarray(np.moveaxis(cube.astype(np.float32), 2, 0))
+    for block_bytes in (1, 23 * 31 * np.dtype(dtype).itemsize * 5, 1 << 30):
+        monkeypatch.setattr(radiance, "BAND_PLANES_BLOCK_BYTES", block_bytes)
+        planes = radiance.band_planes(cube)
+        assert planes.dtype == np.float32 and planes.flags.c_contiguous and np.array_equal(planes, want)
+    stored = np.moveaxis(want, 0, 2)  # (rows, cols, bands), stored band by band
+    assert np.shares_memory(radiance.band_planes(stored), want)
