@@ -4,7 +4,7 @@
 # 640 and native passes from the same inference), the illuminance sweep, the MTF50 groups'
 # pairs, docs/data/metric-300's tables, the report and the 13 reference submissions, then
 # day_paper. Each step skips what is done (generate and sweep resume unit by unit and scene
-# by scene; verify leaves a marker), so after a killed session run the same command again.
+# by scene; generate and verify leave a marker when done), so after a killed session run the same command again.
 # Long: about 11.5 h of generation and 4-5 h of sweep on 2 AVX2 cores (docs/performance.md).
 #
 #   nohup setsid bash benchmarks/metric300_chain.sh /work/m300 >> /work/m300-chain.log 2>&1 &
@@ -37,7 +37,12 @@ mapfile -t HEAP_MALLOC < <(grep -v '^#' benchmarks/heap-malloc.env)
 # timed STEP COMMAND...: the command, then "== STEP (this sitting): N s wall" (a resumed step counts its sitting only)
 timed() { local step=$1 t0; shift; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $step (this sitting): $(( $(date +%s) - t0 )) s wall"; }
 
-timed generate metricscenes generate --manifest "$MANIFEST" --out "$COLLECTION" --workers 1
+# A finished collection is not checked again at every restart (generate reads every unit back:
+# ≈ 8 min for metric-300); verify below reads it all once, and every later read checks what it reads.
+if [ ! -e "$WORK/generated" ]; then
+  timed generate metricscenes generate --manifest "$MANIFEST" --out "$COLLECTION" --workers 1
+  touch "$WORK/generated"
+fi
 if [ ! -e "$WORK/verified" ]; then
   timed verify env "${HEAP_MALLOC[@]}" metricscenes verify "$COLLECTION"
   touch "$WORK/verified"
