@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, pixels_to_tan, tan_to_pixels, world_to_tan
 from metricscenes import radiance
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, pixels_to_tan, tan_to_pixels, world_to_tan
 from metricscenes.radiance import RadianceLayer, SpectralScene, feather_weights
 
 
