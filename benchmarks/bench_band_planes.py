@@ -7,7 +7,7 @@ best of ``--repeat``, checks that they are identical, and prints the times and t
 
     PYTHONPATH=. python benchmarks/bench_band_planes.py --collection /work/collections/metric-300-first2
 
-Results: docs/performance.md, "A capture's time on this machine".
+Results: docs/performance.md, "A camera run and the 13-camera sweep".
 """
 
 from __future__ import annotations

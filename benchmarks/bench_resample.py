@@ -9,7 +9,7 @@ store before each grid, which is what every grid did before), alternating, best 
 
     PYTHONPATH=. python benchmarks/bench_resample.py --collection collections/quick --condition night
 
-Results: docs/performance.md, "A capture's time on this machine".
+Results: docs/performance.md, "A camera run and the 13-camera sweep".
 """
 
 from __future__ import annotations
