@@ -47,8 +47,22 @@ def test_ap_falls_with_distance_by_day_for_every_camera_at_paper_parity(paper_pa
     assert findings["ap_falls_with_distance"] and findings["ap_distance_rho_worst"] <= -0.8
 
 
+NIGHT_AT_200_M = (
+    "Measured on metric-300's runs before the tables were published (session 25), as on quick: on "
+    "the paper's night the two coarsest cameras score a few low boxes on a car 200 m away, AP 0.034 "
+    "and 0.038 against 0.003 and 0.030 by day (cam01, cam02); every other camera and distance is "
+    "below day (docs/results.md, \"The nights and dusk on metric-300\")")
+
+
+@pytest.mark.xfail(strict=True, reason=NIGHT_AT_200_M)
 def test_the_papers_night_is_below_day_at_every_distance(reference):
     assert paper_night_findings(*reference)["night_below_day_everywhere"]
+
+
+def test_the_papers_night_is_below_day_wherever_either_sees_the_car(reference):
+    """Night below day at every camera and distance where day or night AP reaches 0.1."""
+    findings = paper_night_findings(*reference)
+    assert findings["night_day_seen_cells"] > 13 * 4 and findings["night_below_day_where_seen"]
 
 
 def test_day_od50_rises_with_mtf50(reference):

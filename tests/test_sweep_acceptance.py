@@ -125,3 +125,21 @@ def test_night_findings_need_dusk_rows():
     table, od = night_tables(lambda cam, d: 0.1)
     with pytest.raises(ValueError, match="dusk"):
         night_findings(table[table["condition"] != "dusk"], od)
+
+
+# --- issue 23/25: the paper's night below day, where either light sees the car ---------------
+
+def test_paper_night_below_day_where_seen_ignores_cells_neither_light_sees():
+    from benchmark.experiments.acceptance import paper_night_findings
+
+    table, od = night_tables(lambda cam, d: 0.4 * np.exp(-d / 120))
+    far = (table["camera"] == "cam01") & (table["distance_m"] == 200.0)
+    table.loc[far & (table["condition"] == "day"), "ap"] = 0.01  # a far car both lights barely see
+    table.loc[far & (table["condition"] == "night"), "ap"] = 0.03
+    res = paper_night_findings(table, od)
+    assert not res["night_below_day_everywhere"]
+    assert res["night_below_day_where_seen"] and res["night_day_seen_cells"] == len(MTF50) * len(DISTANCES) - 1
+
+    near = (table["camera"] == "cam02") & (table["distance_m"] == 25.0) & (table["condition"] == "night")
+    table.loc[near, "ap"] = 0.95  # night above a seen day: the finding fails
+    assert not paper_night_findings(table, od)["night_below_day_where_seen"]

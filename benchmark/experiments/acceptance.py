@@ -138,7 +138,7 @@ PAPER_NIGHT_USEFUL_MIN_CAMERAS = 10
 
 
 def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", night: str = "night",
-                         near_m: float = 25.0) -> dict[str, bool | float | int]:
+                         near_m: float = 25.0, seen_ap: float = 0.1) -> dict[str, bool | float | int]:
     """The paper's night (Liu et al. 2023: 0.1-1 lux mean image-plane illuminance, every lamp
     on), judged as issue 23 asks, every camera of the table:
 
@@ -146,6 +146,9 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
       (``night_ap_near_useful_cameras``: how many);
     - ``night_below_day_everywhere``: night AP < day AP at every distance, every camera
       (a tie at zero counts against it);
+    - ``night_below_day_where_seen``: the same, over the cells (camera × distance) where day or
+      night AP reaches ``seen_ap`` (``night_day_seen_cells``: how many), so that a few low
+      boxes on a far car both lights barely see do not decide it;
     - ``night_od50_reported``: every night OD50 inside the measured distances or censored
       (a bound, "> 200" or "< 25"), none infinite or extrapolated;
     - ``night_od50_rises_with_mtf50``: Spearman rho of night OD50 against MTF50 > 0
@@ -162,11 +165,14 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
     reported = censored | ((values >= lo) & (values <= hi))
     ranked = np.where(censored, od_night["bound_m"].astype(float), values)
     useful = int((ap_night[near_m] >= PAPER_NIGHT_AP_25M_MIN).sum())
+    seen = ((ap_day >= seen_ap) | (ap_night >= seen_ap)).to_numpy()
     rho = _spearman(od_night["mtf50_cy_per_mm"], pd.Series(ranked).replace(np.inf, 1e12))
     return {
         "night_ap_near_useful": useful >= PAPER_NIGHT_USEFUL_MIN_CAMERAS,
         "night_ap_near_useful_cameras": useful,
         "night_below_day_everywhere": bool((ap_night < ap_day).to_numpy().all()),
+        "night_below_day_where_seen": bool((ap_night < ap_day).to_numpy()[seen].all()),
+        "night_day_seen_cells": int(seen.sum()),
         "night_od50_reported": bool(reported.all()),
         "night_od50_rises_with_mtf50": bool(rho > 0),
         "night_od50_mtf50_rho": rho,
