@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmark.experiments.acceptance import ap_distance_rho, night_findings, paper_findings
+from benchmark.experiments.acceptance import ap_distance_rho, night_findings, paper_findings, paper_night_findings
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 MTF50 = {"cam01": 60.0, "cam02": 80.0, "cam03": 110.0, "cam04": 150.0}
@@ -130,8 +130,6 @@ def test_night_findings_need_dusk_rows():
 # --- issue 23/25: the paper's night below day, where either light sees the car ---------------
 
 def test_paper_night_below_day_where_seen_ignores_cells_neither_light_sees():
-    from benchmark.experiments.acceptance import paper_night_findings
-
     table, od = night_tables(lambda cam, d: 0.4 * np.exp(-d / 120))
     far = (table["camera"] == "cam01") & (table["distance_m"] == 200.0)
     table.loc[far & (table["condition"] == "day"), "ap"] = 0.01  # a far car both lights barely see

@@ -165,13 +165,14 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
     reported = censored | ((values >= lo) & (values <= hi))
     ranked = np.where(censored, od_night["bound_m"].astype(float), values)
     useful = int((ap_night[near_m] >= PAPER_NIGHT_AP_25M_MIN).sum())
+    below = (ap_night < ap_day).to_numpy()
     seen = ((ap_day >= seen_ap) | (ap_night >= seen_ap)).to_numpy()
     rho = _spearman(od_night["mtf50_cy_per_mm"], pd.Series(ranked).replace(np.inf, 1e12))
     return {
         "night_ap_near_useful": useful >= PAPER_NIGHT_USEFUL_MIN_CAMERAS,
         "night_ap_near_useful_cameras": useful,
-        "night_below_day_everywhere": bool((ap_night < ap_day).to_numpy().all()),
-        "night_below_day_where_seen": bool((ap_night < ap_day).to_numpy()[seen].all()),
+        "night_below_day_everywhere": bool(below.all()),
+        "night_below_day_where_seen": bool(below[seen].all()),
         "night_day_seen_cells": int(seen.sum()),
         "night_od50_reported": bool(reported.all()),
         "night_od50_rises_with_mtf50": bool(rho > 0),
