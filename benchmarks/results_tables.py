@@ -42,8 +42,8 @@ def publish(results: Path, out: Path, collection: str = "quick") -> None:
     out.mkdir(parents=True, exist_ok=True)
     for suffix, folder_suffix in SWEEPS.items():
         folder = collection + folder_suffix
-        if not (results / folder).is_dir():
-            print(f"no {results / folder}: {out}/sweep{suffix}.csv and od50{suffix}.csv left as they are")
+        if not (results / folder / "sweep.csv").is_file():  # absent, or a sweep still under way
+            print(f"no {results / folder}/sweep.csv: {out}/sweep{suffix}.csv and od50{suffix}.csv left as they are")
             continue
         for name in ("sweep", "od50"):
             (out / f"{name}{suffix}.csv").write_bytes((results / folder / f"{name}.csv").read_bytes())
