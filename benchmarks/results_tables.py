@@ -241,26 +241,32 @@ def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tu
     return "\n".join(lines) + f"\n\nSpearman's ρ of the two orders ({len(cameras)} cameras): {_minus(f'{rho:.2f}')}"
 
 
-def markdown(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> str:
+def tables(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> dict[str, str]:
+    """The tables of docs/results.md that ``data`` (and ``against``) hold, by their headings."""
     table, od50 = _load(data, "")
-    parts = [f"### {c}\n\n{ap_table(table, od50, c)}" for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])]
+    parts = {c: ap_table(table, od50, c) for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])}
     if set(NIGHTS) <= set(table["condition"]):
-        parts.append(f"### the nights side by side\n\n{three_nights_table(data)}")
+        parts["the nights side by side"] = three_nights_table(data)
     if (data / "od50-native.csv").exists() and (data / "od50-640.csv").exists():
-        parts.append(f"### input size (day)\n\n{input_size_table(data)}")
+        parts["input size (day)"] = input_size_table(data)
     if (data / "od50-policies.csv").exists():
-        parts.append(f"### policies\n\n{policy_tables(data)}")
+        parts["policies"] = policy_tables(data)
     if (data / "od50-illuminance.csv").exists():
-        parts.append(f"### illuminance\n\n{illuminance_table(data)}")
+        parts["illuminance"] = illuminance_table(data)
     if (data / "od50-day-paper.csv").exists():
-        parts.append(f"### day_paper\n\n{day_paper_table(data)}")
+        parts["day_paper"] = day_paper_table(data)
     if (data / "night-factors.csv").exists():
-        parts.append(f"### night factors\n\n{night_factors_table(data)}")
+        parts["night factors"] = night_factors_table(data)
     if against is not None:
         loaded = [_load(against, ""), (table, od50)]
         shared = [c for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"]) and c in set(loaded[0][0]["condition"])]
-        parts += [f"### {c}: {names[1]} against {names[0]}\n\n{collections_table(loaded, names, c)}" for c in shared]
-    return "\n\n".join(parts)
+        parts |= {f"{c}: {names[1]} against {names[0]}": collections_table(loaded, names, c) for c in shared}
+    return parts
+
+
+def markdown(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> str:
+    """``tables`` as markdown, each under its ``###`` heading."""
+    return "\n\n".join(f"### {heading}\n\n{text}" for heading, text in tables(data, against, names).items())
 
 
 def main() -> None:
