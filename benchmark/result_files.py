@@ -12,6 +12,7 @@ record (bad JSON, a missing column, a field of the wrong type):
 | ``sweep.csv`` | :class:`SweepRow`, one per row | :func:`read_sweep_table` / :func:`write_sweep_table` | sweep | report, spm, acceptance, cli |
 | ``od50.csv`` | :class:`Od50Row`, one per row | :func:`read_od50_table` / :func:`write_od50_table` | sweep | report, spm, acceptance, cli |
 | ``sweep.json`` | :class:`SweepRecord` | :func:`read_sweep_record` / :func:`write_sweep_record` | sweep | report, compare |
+| ``images.sha256`` | {image file: sha256} | :func:`read_image_hashes` / :func:`write_image_hashes` | ``experiments.run`` | ``run.read_captures`` (``--captures-from``) |
 
 Units, everywhere: AP and AP50 are unitless (COCO AP of the car, 0 to 1; NaN at a distance
 whose images hold no car); distances and OD50 are in metres (``_m``); exposures and timings
@@ -187,6 +188,29 @@ def read_results(path: str | Path) -> RunResults:
 def write_results(path: str | Path, results: RunResults) -> Path:
     """Write ``results.json`` atomically: the fields set, one-space indent (as run.py always wrote it)."""
     return write_atomic(path, json.dumps(_fields_set(results), indent=1))
+
+
+# ── images.sha256: the sha256 of each camera image a run saved ────────────────────────────
+
+IMAGE_HASHES_FILE = "images.sha256"
+
+
+def write_image_hashes(path: str | Path, hashes: dict[str, str]) -> Path:
+    """Write ``images.sha256`` atomically: one ``<sha256>  images/<file>`` line per image, sorted
+    by file name (the format ``sha256sum -c images.sha256`` checks in the run folder)."""
+    return write_atomic(path, "".join(f"{digest}  images/{name}\n" for name, digest in sorted(hashes.items())))
+
+
+def read_image_hashes(path: str | Path) -> dict[str, str]:
+    """{image file name: sha256} of an ``images.sha256`` (OSError if it cannot be read)."""
+    path = Path(path)
+    hashes = {}
+    for number, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+        digest, _, name = line.partition("  images/")
+        if len(digest) != 64 or not all(c in "0123456789abcdef" for c in digest) or not name or "/" in name:
+            raise ResultsFileError(f"{path}: line {number} is not '<sha256>  images/<file>'")
+        hashes[name] = digest
+    return hashes
 
 
 # ── od50.json: a run's bootstrap OD50, cached next to its detections ─────────────────────

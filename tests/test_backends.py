@@ -189,7 +189,7 @@ def test_cameras_run_together_write_what_each_writes_alone(serial_collection, tm
 def test_a_sweep_on_another_sweeps_captures_detects_the_same(serial_collection, tmp_path, monkeypatch):
     """--captures-from: a 640 sweep that detects on a native sweep's images writes what a 640
     sweep that simulates the cameras writes, without simulating them; a capture of another
-    seed is not taken, and a damaged image is a one-line error."""
+    seed is not taken, and an image whose bytes are not those its run recorded is a one-line error."""
     require_model("yolov5n-dynamic.onnx")
     from benchmark.detectors import load_detector
     from benchmark.experiments import run as run_module
@@ -222,7 +222,7 @@ def test_a_sweep_on_another_sweeps_captures_detects_the_same(serial_collection, 
         run_module.read_captures(tmp_path / "native" / "runs" / "small-a-day", cameras[0], "day", collection, seed=1)
     image = next((tmp_path / "native" / "runs" / "small-a-day" / "images").iterdir())
     image.write_bytes(image.read_bytes()[:100])
-    with pytest.raises(ValueError, match=r"^captures .*: unreadable image"):
+    with pytest.raises(ValueError, match=r"^captures .*: its bytes changed since its run wrote it"):
         run_module.run_camera(collection, cameras[0], "day", at_640, tmp_path / "damaged",
                               captures=tmp_path / "native" / "runs" / "small-a-day")
     assert not (tmp_path / "damaged").exists()

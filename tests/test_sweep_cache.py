@@ -307,3 +307,56 @@ def test_mtf_policy_falls_through_sources_that_give_nothing(monkeypatch):
     assert source == "analytic" and value == mtf_module.camera_mtf50(cam, "analytic")[0]
     monkeypatch.setattr(mtf_module, "mtf50_analytic_cy_per_mm", lambda *a, **k: float("nan"))
     assert mtf_module.camera_mtf50(cam.model_copy(update={"mtf50_group_cy_per_mm": None})) == (None, "none")
+
+
+# --- camera images read back; what failed or killed sweeps leave ---------------------------
+
+def seeded_capture(radiance, camera, seed):
+    """A replaced ``simulate`` for the real run_camera: noise of the camera's size, seeded by the scene."""
+    capture = BlankCapture()
+    capture.rgb8 = np.random.default_rng(seed).integers(0, 256, (camera.height_px, camera.width_px, 3), np.uint8)
+    return capture
+
+
+def small_camera(folder: Path):
+    spec = folder / "small.yaml"
+    spec.write_text("name: small\noptics: {f_number: 2.0}\nsensor: {pixel_um: 11.2}\n")  # 240 x 135 px
+    return load_camera(spec)
+
+
+def test_an_image_changed_after_its_run_wrote_it_is_refused_where_it_is_read_back(tmp_path, monkeypatch):
+    """A run records each image's sha256 (images.sha256, sha256sum's format). Runs that detect on
+    its images (--captures-from) hold them as hard links, so a `cp` over one in any folder
+    changes it in all: a run reading it back refuses it in one line and writes nothing."""
+    import hashlib
+    import re
+    import shutil
+
+    import benchmark.camera.pipeline
+    from benchmark.experiments.run import read_captures, run_camera
+
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", seeded_capture)
+    camera, collection = small_camera(tmp_path), BlankCollection(tmp_path)
+    first, reader = tmp_path / "first", tmp_path / "reader"
+    run_camera(collection, camera, "day", BlindDetector(), first)
+    images = sorted((first / "images").iterdir())
+    assert (first / "images.sha256").read_text() == "".join(
+        f"{hashlib.sha256(p.read_bytes()).hexdigest()}  images/{p.name}\n" for p in images)
+    run_camera(collection, camera, "day", BlindDetector(), reader, captures=first)
+    assert (reader / "images.sha256").read_bytes() == (first / "images.sha256").read_bytes()
+
+    black = tmp_path / "black.png"
+    from PIL import Image
+
+    Image.fromarray(np.zeros((camera.height_px, camera.width_px, 3), np.uint8)).save(black)
+    shutil.copyfile(black, reader / "images" / images[0].name)  # as `cp` does: written through the shared file
+    assert images[0].read_bytes() == black.read_bytes()  # the first run's image changed too
+    with pytest.raises(ValueError, match=rf"^captures {re.escape(str(images[0]))}: its bytes changed since its run "
+                                         r"wrote it \(sha256 [0-9a-f]{12}\.\.\., images.sha256 records") as refused:
+        run_camera(collection, camera, "day", BlindDetector(), tmp_path / "again", captures=first)
+    assert "\n" not in str(refused.value) and not (tmp_path / "again").exists()
+
+    run_camera(collection, camera, "day", BlindDetector(), first, save_images=False)  # its old images vouched for no more
+    assert not (first / "images.sha256").exists()
+    with pytest.raises(ValueError, match="no images.sha256"):
+        read_captures(first, camera, "day", collection, 0)

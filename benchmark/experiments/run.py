@@ -10,7 +10,11 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
   the camera's pixels;
 - ``groundtruth.json``: the collection's ground truth on the camera's grid (scaled, or
   mapped onto the camera's window of the field: :func:`camera_geometry`);
-- ``images/<scene>.png``: the camera's sRGB images (optional).
+- ``images/<scene>.png``: the camera's sRGB images (optional), and ``images.sha256``, the
+  sha256 of each (``sha256sum`` format). Runs that share an image hold it as one file (hard
+  links), so a write over it in one folder changes it in all of them: a run that reads images
+  back (``captures``) checks each against the sha256 its run recorded and refuses one whose
+  bytes changed.
 
 The camera's images depend on the camera, condition, collection and seed only
 (:func:`capture_key`), not on the detector: a run given ``captures`` (an earlier run folder
@@ -38,10 +42,14 @@ from pathlib import Path
 import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
+from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
+    CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
+)
+from metricscenes.files import sha256_file
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
-    RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
-    write_results,
+    IMAGE_HASHES_FILE, RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP,
+    RunResults, Subset, write_image_hashes, write_results,
 )
 
 # How the collection's layers are composited for a camera (metricscenes.store.Collection.radiance):
@@ -137,10 +145,20 @@ def results_capture_key(results: RunResults) -> dict:
     return key
 
 
-def read_captures(captures, camera, condition: str, collection, seed: int) -> RunResults:
-    """The results of the run folder ``captures`` if its images can stand for this run's
-    camera (same :func:`capture_key`, an image for every scene); ValueError (one line) if not."""
-    from benchmark.result_files import ResultsFileError, read_results
+@dataclass(frozen=True)
+class Captures:
+    """A finished run folder whose camera images stand for another run's (:func:`read_captures`)."""
+
+    folder: Path
+    results: RunResults
+    image_sha256: dict[str, str]  # image file name -> sha256 of the bytes its run wrote (images.sha256)
+
+
+def read_captures(captures, camera, condition: str, collection, seed: int) -> Captures:
+    """The run folder ``captures`` if its images can stand for this run's camera (same
+    :func:`capture_key`, an image and its recorded sha256 for every scene); ValueError (one
+    line) if not. Each image's bytes are checked when it is read (:func:`_captured_image`)."""
+    from benchmark.result_files import ResultsFileError, read_image_hashes, read_results
 
     captures = Path(captures)
     try:
@@ -149,26 +167,47 @@ def read_captures(captures, camera, condition: str, collection, seed: int) -> Ru
         raise ValueError(f"captures {captures}: no finished run there ({str(exc).splitlines()[0]})") from None
     if results_capture_key(results) != capture_key(camera, condition, collection, seed):
         raise ValueError(f"captures {captures}: made with another camera, condition, collection or seed")
-    missing = [s.scene_id for s in collection.scenes() if not (captures / "images" / f"{s.scene_id}.png").is_file()]
+    try:
+        hashes = read_image_hashes(captures / IMAGE_HASHES_FILE)
+    except OSError:
+        raise ValueError(f"captures {captures}: no {IMAGE_HASHES_FILE} (its images were saved before their sha256 "
+                         "was recorded, or not at all): run it again to use its images") from None
+    except ResultsFileError as exc:
+        raise ValueError(f"captures {exc}") from None
+    missing = [s.scene_id for s in collection.scenes()
+               if f"{s.scene_id}.png" not in hashes or not (captures / "images" / f"{s.scene_id}.png").is_file()]
     if missing:
         raise ValueError(f"captures {captures}: no image of {len(missing)} scene(s), e.g. {missing[0]}.png")
-    return results
+    return Captures(captures, results, hashes)
 
 
-def _captured_image(captures: Path, scene_id: str, camera) -> np.ndarray:
-    """The 8-bit sRGB image a run saved of ``scene_id`` (PNG: the very array it detected on)."""
+def _captured_image(captures: Captures, scene_id: str, camera) -> tuple[np.ndarray, str]:
+    """The 8-bit sRGB image a run saved of ``scene_id`` (PNG: the very array it detected on)
+    and its sha256, which must be the one its run recorded: an image is a hard link shared by
+    several runs' folders, and one write over it in any of them changes it in all."""
+    import io
+
     from PIL import Image
 
-    path = captures / "images" / f"{scene_id}.png"
+    path = captures.folder / "images" / f"{scene_id}.png"
     try:
-        with Image.open(path) as image:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"captures {path}: unreadable image ({exc.strerror or type(exc).__name__})") from None
+    digest, recorded = sha256_bytes(data), captures.image_sha256[path.name]
+    if digest != recorded:
+        raise ValueError(f"captures {path}: its bytes changed since its run wrote it (sha256 {digest[:12]}..., "
+                         f"{IMAGE_HASHES_FILE} records {recorded[:12]}...): detect without --captures-from, or remove "
+                         f"{captures.folder} and run the sweep that made it again")
+    try:
+        with Image.open(io.BytesIO(data)) as image:
             rgb8 = np.asarray(image)
     except OSError as exc:
         raise ValueError(f"captures {path}: unreadable image ({str(exc).splitlines()[0]})") from None
     if rgb8.dtype != np.uint8 or rgb8.shape != (camera.height_px, camera.width_px, 3):
         raise ValueError(f"captures {path}: {rgb8.shape} {rgb8.dtype} image, the camera makes "
                          f"({camera.height_px}, {camera.width_px}, 3) uint8")
-    return rgb8
+    return rgb8, digest
 
 
 def _compact(values) -> str:
@@ -375,7 +414,7 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
         raise ValueError("run_cameras needs a distinct output folder per camera")
     field = collection_field(collection)
     windows = [camera_window(camera, field) for camera in cameras]  # a camera wider than the collection: refused here
-    captured = [None if c is None else (Path(c), read_captures(c, camera, condition, collection, seed))
+    captured = [None if c is None else read_captures(c, camera, condition, collection, seed)
                 for camera, c in zip(cameras, captures)]
     created = [[p for p in (d, *d.parents) if not p.exists()] for d in every]
     interrupted = False
@@ -406,7 +445,7 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
                 raise
             for dirs, row in zip(folders, stages):
                 for d, stage in zip(dirs, row):
-                    _move_into_place(stage, d, save_images)
+                    move_into_place(stage, d, save_images)
             return results
     except BaseException:
         for made in created:  # the folders these runs made, innermost first, if still empty
@@ -428,14 +467,6 @@ def check_pass_policies(detector, sizes) -> None:
                              f" (its passes: {', '.join(map(str, passes)) or 'one, its own'})")
 
 
-STAGE_PREFIX = ".partial-"
-RESUMABLE_STAGE = STAGE_PREFIX + "resume"
-"""The staging folder a run writes scene by scene (``scenes.jsonl``: each finished scene's
-detections and exposures, written after its image) and a killed run resumes from."""
-STAGE_KEY = "resume-key.json"
-CHECKPOINT = "scenes.jsonl"
-
-
 def resume_key(camera, condition: str, collection, seed: int, detectors: list, save_images: bool,
                captures) -> dict:
     """What a staged run's scenes depend on: its capture key, the detectors' model and input
@@ -444,44 +475,6 @@ def resume_key(camera, condition: str, collection, seed: int, detectors: list, s
     return {"capture": capture_key(camera, condition, collection, seed),
             "detectors": [[d.sha256, str(d.input_size), repr(getattr(d, "class_map", None))] for d in detectors],
             "save_images": bool(save_images), "captures": None if captures is None else str(captures)}
-
-
-def resumable_stage(out_dir: Path, key: dict) -> tuple[Path, bool]:
-    """``out_dir``'s resumable staging folder and whether it is resumed: the one a run with
-    the same ``key`` left (killed or interrupted), else a new one (another key's is removed)."""
-    stage, text = out_dir / RESUMABLE_STAGE, json.dumps(key, sort_keys=True)
-    try:
-        if (stage / STAGE_KEY).read_text() == text:
-            return stage, True
-    except (OSError, UnicodeDecodeError):
-        pass
-    shutil.rmtree(stage, ignore_errors=True)
-    stage.mkdir()
-    (stage / STAGE_KEY).write_text(text)
-    return stage, False
-
-
-def remove_stale_stages(out_dir: Path) -> list[Path]:
-    """Remove the staging folders (``.partial-*``) that runs killed in ``out_dir`` left
-    behind, but the resumable one (:func:`resumable_stage` judges it); the caller holds the
-    folder's lock, so none is in use. Returns them."""
-    stale = sorted(p for p in out_dir.glob(f"{STAGE_PREFIX}*")
-                   if p.is_dir() and not p.is_symlink() and p.name != RESUMABLE_STAGE)
-    for folder in stale:
-        shutil.rmtree(folder, ignore_errors=True)
-    return stale
-
-
-def _move_into_place(stage: Path, out_dir: Path, save_images: bool) -> None:
-    """A finished run's outputs from its staging folder into ``out_dir``, one rename a file:
-    images, detections and ground truth, then results.json last (a sweep takes a run folder
-    with its results.json as finished)."""
-    if save_images:
-        (out_dir / "images").mkdir(exist_ok=True)
-        for image in sorted((stage / "images").iterdir()):
-            os.replace(image, out_dir / "images" / image.name)
-    for name in ("detections.json", "groundtruth.json", "results.json"):
-        os.replace(stage / name, out_dir / name)
 
 
 def grid_key(camera) -> tuple:
@@ -520,11 +513,10 @@ class _CameraRun:
     scenes one by one (simulate or read the captured image, detect, save), :meth:`finish`
     scores them and writes detections, ground truth and results.json in each stage.
     ``window`` is the part of the collection's ``field`` the camera samples (and its ground
-    truth follows); ``captures``: (folder, results) of the run whose images stand for the
-    camera's."""
+    truth follows); ``captures``: the run whose images stand for the camera's."""
 
     def __init__(self, collection, camera, condition: str, detectors: list, stages: list[Path], field, window, *,
-                 seed: int, save_images: bool, backend: str, captures: tuple[Path, RunResults] | None):
+                 seed: int, save_images: bool, backend: str, captures: Captures | None):
         self.collection, self.camera, self.condition, self.detectors = collection, camera, condition, detectors
         self.stages, self.field, self.window = stages, field, window
         self.seed, self.save_images, self.backend, self.captures = seed, save_images, backend, captures
@@ -535,6 +527,7 @@ class _CameraRun:
         self.exposures: dict[str, float] = {}
         self.short_exposures: dict[str, float] = {}  # the hdr policy's second frame
         self.targeted: dict[str, dict] = {}  # a targeted condition's target and weights per scene
+        self.image_sha256: dict[str, str] = {}  # image file name -> sha256 of its bytes (images.sha256)
         self.checkpoint = stages[0] / CHECKPOINT
         self.done = self._staged_scenes()  # scenes an interrupted run of the same key finished
 
@@ -577,6 +570,9 @@ class _CameraRun:
             self.exposures[scene.scene_id] = staged["exposure_s"]
             if staged["exposure_short_s"] is not None:
                 self.short_exposures[scene.scene_id] = staged["exposure_short_s"]
+            if self.save_images:  # (a stage begun before images had their sha256 recorded: hashed now)
+                name = f"{scene.scene_id}.png"
+                self.image_sha256[name] = staged.get("image_sha256") or sha256_file(self.stages[0] / "images" / name)
             return
         found_here = [len(d) for d in self.detections]
         if captures is None:
@@ -589,10 +585,10 @@ class _CameraRun:
                 self.short_exposures[scene.scene_id] = capture.exposure_short_s
         else:
             t = time.perf_counter()
-            rgb8 = _captured_image(captures[0], scene.scene_id, camera)
-            self.exposures[scene.scene_id] = captures[1].exposure_s[scene.scene_id]
-            if captures[1].exposure_short_s is not None:
-                self.short_exposures[scene.scene_id] = captures[1].exposure_short_s[scene.scene_id]
+            rgb8, captured_sha256 = _captured_image(captures, scene.scene_id, camera)
+            self.exposures[scene.scene_id] = captures.results.exposure_s[scene.scene_id]
+            if captures.results.exposure_short_s is not None:
+                self.short_exposures[scene.scene_id] = captures.results.exposure_short_s[scene.scene_id]
             timings.add("read_captures", t)
         t = time.perf_counter()
         # multi_label: every class above threshold per box, as YOLOv5's val.py does for COCO mAP.
@@ -617,14 +613,18 @@ class _CameraRun:
             source = self.stages[0] / "images" / name
             if captures is None:
                 Image.fromarray(rgb8).save(source, compress_level=1)
+                self.image_sha256[name] = sha256_file(source)
             else:
-                link_or_copy(captures[0] / "images" / name, source)
+                link_or_copy(captures.folder / "images" / name, source)
+                self.image_sha256[name] = captured_sha256
             for stage in self.stages[1:]:
                 link_or_copy(source, stage / "images" / name)
             timings.add("save_images", t)
         entry = {"scene_id": scene.scene_id, "detections": [d[n:] for d, n in zip(self.detections, found_here)],
                  "exposure_s": self.exposures[scene.scene_id],
                  "exposure_short_s": self.short_exposures.get(scene.scene_id)}
+        if self.save_images:
+            entry["image_sha256"] = self.image_sha256[f"{scene.scene_id}.png"]
         with open(self.checkpoint, "a") as f:  # after the image: a scene listed here is whole
             f.write(json.dumps(entry) + "\n")
 
@@ -690,23 +690,13 @@ class _CameraRun:
         if self.short_exposures:  # hdr only; exposure_s holds the long frames
             results.exposure_short_s = self.short_exposures
         if self.captures is not None:  # detected on an earlier run's images
-            results.captures_from = str(self.captures[0])
+            results.captures_from = str(self.captures.folder)
+        if self.save_images:
+            write_image_hashes(stage / IMAGE_HASHES_FILE, self.image_sha256)
         (stage / "detections.json").write_bytes(detections_bytes)
         (stage / "groundtruth.json").write_text(json.dumps(groundtruth))
         write_results(stage / "results.json", results)
         return results
-
-
-def link_or_copy(source: Path, target: Path) -> None:
-    """``target`` as a hard link to ``source`` (a camera image is written once and never
-    changed, so runs that share it need not hold a copy each), or a copy where the file
-    system cannot link. A ``target`` already there (a scene a killed run had begun) is
-    replaced, never written through: it may be a link to ``source`` itself."""
-    target.unlink(missing_ok=True)
-    try:
-        os.link(source, target)
-    except OSError:
-        shutil.copyfile(source, target)
 
 
 def camera_record(camera) -> CameraRecord:
