@@ -3,7 +3,9 @@ hold, and the one rule every ``--out`` follows.
 
 - a **collection** (``metricscenes generate``): :func:`metricscenes.store.collection_containing`;
 - a **run folder** (``benchmark run``): it holds ``results.json``;
-- a **sweep folder** (``benchmark sweep``): it holds ``sweep.json`` or ``sweep.csv``;
+- a **sweep folder** (``benchmark sweep``): it holds ``sweep.json`` or ``sweep.csv`` (written
+  when the sweep ends) or ``sweep.started`` (written when it starts, so that a sweep still
+  running, or killed, is one too);
 - a **leaderboard** (``benchmark submit`` and ``leaderboard``): it holds ``submissions/``
   or ``protocols.yaml``.
 
@@ -23,7 +25,9 @@ from pathlib import Path
 
 COLLECTION, RUN, SWEEP, LEADERBOARD = "collection", "run folder", "sweep folder", "leaderboard"
 RUN_MARKERS = ("results.json",)
-SWEEP_MARKERS = ("sweep.json", "sweep.csv")
+SWEEP_STAMP = "sweep.started"
+SWEEP_MARKERS = ("sweep.json", "sweep.csv", SWEEP_STAMP)
+SWEEP_STAMP_TEXT = "a `benchmark sweep` folder: its runs are in runs/, its tables (sweep.csv, sweep.json) when it ends\n"
 LEADERBOARD_MARKERS = ("submissions", "protocols.yaml")
 WHY = {
     COLLECTION: "collections are written only by `metricscenes generate`",

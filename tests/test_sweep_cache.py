@@ -360,3 +360,90 @@ def test_an_image_changed_after_its_run_wrote_it_is_refused_where_it_is_read_bac
     assert not (first / "images.sha256").exists()
     with pytest.raises(ValueError, match="no images.sha256"):
         read_captures(first, camera, "day", collection, 0)
+
+
+def test_a_running_sweep_folder_is_a_sweep_folder(tmp_path, monkeypatch):
+    """A sweep stamps its folder when it starts: while it runs, `run --out` one of its later
+    units (whose rerun once replaced the user's run), `run --out <sweep>/runs` and `export` into
+    it are refused like any sweep folder's (sweep.json, sweep.csv: written at the end), and
+    `report` says it is not finished."""
+    from typer.testing import CliRunner
+
+    from benchmark.cli.main import app as benchmark_app
+    from metricscenes.cli import app as metricscenes_app
+
+    out = tmp_path / "sw"
+    attempts = []
+
+    def meanwhile(done, total, label):
+        if attempts:
+            return
+        for app, args in ((benchmark_app, ["run", "--camera", "cam01", "--collection", tmp_path / "none",
+                                           "--out", out / "runs" / "cam12-night"]),
+                          (benchmark_app, ["run", "--camera", "cam01", "--collection", tmp_path / "none",
+                                           "--out", out / "runs"]),
+                          (metricscenes_app, ["export", tmp_path / "none", out / "x.h5", "--scene", "env000-d025m"])):
+            attempts.append(CliRunner().invoke(app, [str(a) for a in args]))
+        attempts.append(CliRunner().invoke(benchmark_app, ["report", str(out)]))
+
+    make_fake_sweep(out, monkeypatch, progress=meanwhile)
+    assert len(attempts) == 4
+    for result in attempts[:3]:
+        assert result.exit_code == 2 and f"inside the sweep folder {out}" in result.output, result.output
+    assert attempts[3].exit_code == 2 and "is a sweep that has not written its tables yet" in attempts[3].output
+    assert json.loads((out / "runs" / "cam12-night" / "results.json").read_text())["seed"] == 0
+    assert (out / "sweep.started").is_file()
+
+
+def test_a_sweep_killed_after_its_runs_moved_into_place_leaves_nothing_once_rerun(tmp_path, monkeypatch):
+    """A kill between a run's last rename and its clean-up leaves its resumable stage and lock
+    in a finished run folder; the rerun, which reuses that run, removes them (and other staging
+    folders), but keeps the stage another run (another seed) left to resume."""
+    import socket
+    import subprocess
+
+    from benchmark.experiments import run as run_module
+
+    out = tmp_path / "sw"
+    make_fake_sweep(out, monkeypatch)
+    collection, detector = FakeCollection(tmp_path), FakeDetector()
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    for name, seed in (("cam01-day", 0), ("cam12-day", 1)):
+        folder = out / "runs" / name
+        camera = load_camera(name.split("-")[0])
+        run_module.resumable_stage(folder, run_module.resume_key(camera, "day", collection, seed, [detector], False, None))
+        (folder / ".partial-a1b2c3").mkdir()
+        (folder / "benchmark.lock").write_text(json.dumps({"pid": dead.pid, "host": socket.gethostname()}))
+    rerun = CountingRun()
+    make_fake_sweep(out, monkeypatch, run=rerun)
+    assert rerun.calls == []  # every run reused
+    leftovers = sorted(str(p.relative_to(out)) for p in (out / "runs").glob("*/*") if p.name.startswith((".", "bench")))
+    assert leftovers == ["runs/cam12-day/.partial-resume"]  # the seed-1 run's, to resume
+
+
+def test_a_failed_or_one_environment_sweep_leaves_no_folder(tmp_path, monkeypatch):
+    """A sweep that fails before it writes any run (a full disk) leaves no empty runs/ nor its
+    folder; one environment (no bootstrap SD) is refused before any run."""
+    import errno
+
+    from benchmark.experiments.run import subset_collection
+
+    def disk_full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with pytest.raises(OSError, match="No space left"):
+        make_fake_sweep(tmp_path / "new" / "sw", monkeypatch, run=disk_full)
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(OSError, match="No space left"):
+        make_fake_sweep(tmp_path / "mine", monkeypatch, run=disk_full)
+    assert list((tmp_path / "mine").iterdir()) == []  # the user's folder kept, empty as it was
+
+    counting = CountingRun()
+    patch_runs(monkeypatch, counting)
+    one = subset_collection(FakeCollection(tmp_path), "0", None)
+    with pytest.raises(ValueError, match="a sweep needs two or more environments .* this subset has 1: use `benchmark run`"):
+        sweep_module.sweep(one, [load_camera("cam01")], ["day"], FakeDetector(), tmp_path / "one", n_resamples=20,
+                           mtf_source="analytic", save_images=False)
+    assert counting.calls == [] and not (tmp_path / "one").exists()

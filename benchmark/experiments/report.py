@@ -47,6 +47,7 @@ from benchmark.experiments.sweep import (  # noqa: E402
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES  # noqa: E402
 from benchmark.scoring.od50 import format_od50  # noqa: E402
 from metricscenes.manifest import parse_illuminance_condition  # noqa: E402
+from metricscenes.outputs import SWEEP_STAMP  # noqa: E402
 
 GT_COLOUR, DET_COLOUR = (0, 200, 0), (230, 0, 0)
 CAR_CATEGORY_ID = 3
@@ -68,6 +69,9 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
         runs = {(c, k): paths.get((c, k), root / "runs" / run_name(c, k))
                 for c, k in od50[["camera", "condition"]].itertuples(index=False)}
         return table, od50, runs, meta
+    if (root / SWEEP_STAMP).is_file():
+        raise ValueError(f"{root} is a sweep that has not written its tables yet (no sweep.csv: still running, or "
+                         "stopped): run the same `benchmark sweep` again to finish it")
     if not (root / "results.json").is_file():
         raise ValueError(f"{root} is neither a sweep folder (sweep.csv) nor a run folder (results.json)")
     results = read_results(root / "results.json")

@@ -51,6 +51,29 @@ def remove_stale_stages(out_dir: Path) -> list[Path]:
     return stale
 
 
+def remove_finished_leftovers(out_dir: Path, key) -> None:
+    """What a run killed after its files moved into place (before it removed its stage and
+    lock) left in ``out_dir``, whose run is finished: the staging folders, the resumable one
+    where it is of ``key()`` (this very run's :func:`benchmark.experiments.run.resume_key`: nothing in it is needed; another
+    run's is kept for that run), and the stale lock. Untouched while another process holds the lock."""
+    from metricscenes.lock import OUTPUT_LOCK_FILE, LockError, output_lock
+
+    if not (out_dir / OUTPUT_LOCK_FILE).exists() and not any(out_dir.glob(f"{STAGE_PREFIX}*")):
+        return
+    try:
+        with output_lock(out_dir, "benchmark sweep", "run folder"):  # (a stale lock is taken over, then removed)
+            remove_stale_stages(out_dir)
+            stage = out_dir / RESUMABLE_STAGE
+            try:
+                finished = (stage / STAGE_KEY).read_text() == json.dumps(key(), sort_keys=True)
+            except (OSError, UnicodeDecodeError):
+                finished = False
+            if finished:
+                shutil.rmtree(stage, ignore_errors=True)
+    except LockError:
+        pass  # another run is writing there: its own leftovers are its business
+
+
 def move_into_place(stage: Path, out_dir: Path, save_images: bool) -> None:
     """A finished run's outputs from its staging folder into ``out_dir``, one rename a file:
     images and their sha256, detections and ground truth, then results.json last (a sweep

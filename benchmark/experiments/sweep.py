@@ -13,7 +13,7 @@ scene (:func:`benchmark.experiments.run.run_cameras`: each scene read once, resa
 pixel grid), in as many groups of cameras as the backend runs at once (:func:`camera_groups`;
 on a running cluster, one group per pixel grid);
 a group killed midway resumes at its next scene (each run's resumable stage:
-:func:`benchmark.experiments.run.resumable_stage`), with the same bytes. The groups may go to worker processes or a dask cluster
+:func:`benchmark.experiments.run_folder.resumable_stage`), with the same bytes. The groups may go to worker processes or a dask cluster
 (``workers``, ``scheduler``: :mod:`metricscenes.backends`); each run writes only its own run
 folder, and the sweep's tables are written here, in camera × condition order, so their bytes
 do not depend on where the runs ran.
@@ -241,7 +241,10 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         cameras: :class:`CameraSpec` s or names/paths accepted by ``load_camera``.
         conditions: condition names of the collection (``day``, ``night``, ...).
         detector: a loaded detector (:func:`benchmark.detectors.load_detector`).
-        out_dir: sweep folder; runs go to ``out_dir/runs/<camera>-<condition>``.
+        out_dir: sweep folder; runs go to ``out_dir/runs/<camera>-<condition>``. It is stamped
+            (``sweep.started``) when the sweep starts, so that commands take it for a sweep
+            folder while it runs (:mod:`metricscenes.outputs`); a sweep that fails before
+            writing any run leaves nothing of it (nor of ``also``'s).
         seed: sensor-noise seed of every run and the bootstrap seed.
         n_resamples: bootstrap resamples of OD50 (over environments).
         progress: optional ``(done, total, label)`` callable; units are scenes, a cached
@@ -271,12 +274,15 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
     """
     from benchmark.experiments import run as run_module
+    from benchmark.experiments.run_folder import remove_finished_leftovers
     from benchmark.camera.pipeline import camera_window
     from benchmark.camera import load_camera
     from benchmark.camera.exposure import check_exposure_override, exposure_tag, with_exposure
     from benchmark.detectors.policy import parse_input_size
     from metricscenes.backends import check_scheduler, is_remote, map_units, runs_in_process
+    from metricscenes.files import write_atomic
     from metricscenes.lock import output_lock
+    from metricscenes.outputs import SWEEP_STAMP, SWEEP_STAMP_TEXT
     from metricscenes.store import Collection
 
     if mtf_source not in MTF50_SOURCES:
@@ -322,82 +328,118 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                   *(f for s, f in also.items() if s != size)]
         if any(folder.resolve() == other.resolve() for other in others):
             raise ValueError(f"the sweep folder for input size {size}, {folder}, is another of this sweep's folders")
+    environments = {s.environment_id for s in collection.scenes()}
+    if len(environments) < 2:  # refused before any run, not after all of them
+        raise ValueError(f"a sweep needs two or more environments (OD50's SD is a bootstrap over them), this "
+                         f"{'subset' if subset else 'collection'} has {len(environments)}: use `benchmark run` for one")
     detectors = {None: detector, **{size: detector.with_input_size(size) for size in also}}
     folders = {None: out_dir, **also}
-    with ExitStack() as held:
-        for folder in folders.values():
-            folder.mkdir(parents=True, exist_ok=True)
-            held.enter_context(output_lock(folder, "benchmark sweep", "sweep folder"))  # one sweep writes a folder at a time
-            (folder / "runs").mkdir(parents=True, exist_ok=True)
+    made = {folder: [p for p in (folder, *folder.absolute().parents) if not p.exists()] for folder in folders.values()}
+    locked: list[Path] = []
+    try:
+        with ExitStack() as held:
+            for folder in folders.values():
+                folder.mkdir(parents=True, exist_ok=True)
+                held.enter_context(output_lock(folder, "benchmark sweep", "sweep folder"))  # one sweep writes a folder at a time
+                locked.append(folder)
+                if not (folder / SWEEP_STAMP).is_file():  # a sweep folder from now on, not only once its tables are written
+                    write_atomic(folder / SWEEP_STAMP, SWEEP_STAMP_TEXT)
+                (folder / "runs").mkdir(parents=True, exist_ok=True)
 
-        n_scenes = len(collection.scenes())
-        total, done = n_scenes * len(cameras) * len(conditions), 0
-        run_names = {(camera.name, condition): run_name(camera.name, condition, tags[camera.name]) + suffix
-                     for camera in cameras for condition in conditions}
-        run_dirs = {(size, *k): folders[size] / "runs" / name for size in folders for k, name in run_names.items()}
-        results: dict[tuple, RunResults] = {}
-        todo = []
-        for camera in cameras:
+            n_scenes = len(collection.scenes())
+            total, done = n_scenes * len(cameras) * len(conditions), 0
+            run_names = {(camera.name, condition): run_name(camera.name, condition, tags[camera.name]) + suffix
+                         for camera in cameras for condition in conditions}
+            run_dirs = {(size, *k): folders[size] / "runs" / name for size in folders for k, name in run_names.items()}
+            results: dict[tuple, RunResults] = {}
+
+            def captures(camera, condition: str) -> Path | None:
+                if captures_from is None:
+                    return None
+                return captures_for(Path(captures_from) / "runs" / run_names[camera.name, condition],
+                                    camera, condition, collection, seed)
+
+            def resume_key(camera, condition: str) -> dict:  # what the stage of this camera's runs is keyed by
+                return run_module.resume_key(camera, condition, collection, seed, list(detectors.values()),
+                                             save_images, captures(camera, condition))
+
+            todo = []
+            for camera in cameras:
+                for condition in conditions:
+                    cached = {size: cached_results(run_dirs[size, camera.name, condition],
+                                                   run_key(camera, condition, d, collection, seed))
+                              for size, d in detectors.items()}
+                    if any(r is None for r in cached.values()):  # (a missing policy's run: all of them again)
+                        todo.append((camera, condition))
+                        continue
+                    results.update({(size, camera.name, condition): r for size, r in cached.items()})
+                    done += n_scenes
+                    for size in detectors:  # what a kill just after the run's files moved into place left
+                        remove_finished_leftovers(run_dirs[size, camera.name, condition],
+                                                  lambda: resume_key(camera, condition))
+            reused = {(camera_name, condition) for size, camera_name, condition in results}
+            if progress:  # before any unit: a log estimates the time left from what is done after this count
+                progress(done, total, f"{len(reused)} runs cached")
+
+            in_process = runs_in_process(workers, scheduler)
+
+            def scene_progress(label: str, n_cameras: int):
+                # (runs computed here report each scene; ``done`` is read when called: the runs before them)
+                return (lambda d, t: progress(done + d * n_cameras, total, label)) if progress and in_process else None
+
+            # One unit per condition and group of cameras: each scene is read once per unit, and once
+            # per pixel grid resampled; as many groups as the backend runs units at once.
+            luminances = {} if in_process else shared_group_luminances(
+                collection, sorted({c for _, c in todo}), workers=workers, scheduler=scheduler)
+            jobs = []
             for condition in conditions:
-                cached = {size: cached_results(run_dirs[size, camera.name, condition],
-                                               run_key(camera, condition, d, collection, seed))
-                          for size, d in detectors.items()}
-                if any(r is None for r in cached.values()):  # (a missing policy's run: all of them again)
-                    todo.append((camera, condition))
-                    continue
-                results.update({(size, camera.name, condition): r for size, r in cached.items()})
-                done += n_scenes
-        reused = {(camera_name, condition) for size, camera_name, condition in results}
-        if progress:  # before any unit: a log estimates the time left from what is done after this count
-            progress(done, total, f"{len(reused)} runs cached")
+                pending = [camera for camera, c in todo if c == condition]
+                # (a running cluster's size is its own business: there, one group per pixel grid)
+                n_groups = 1 if in_process else len(pending) if is_remote(scheduler) else max(1, workers)
+                for group in camera_groups(pending, n_groups):
+                    label = f"{'+'.join(c.name for c in group)} · {condition}"
+                    jobs.append((collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
+                                 seed, save_images, backend, n_resamples, scene_progress(label, len(group)),
+                                 [captures(c, condition) for c in group],
+                                 {size: [run_dirs[size, c.name, condition] for c in group] for size in also},
+                                 luminances.get(condition)))
+            with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
+                for finished_runs in finished:  # in the order they finish
+                    for camera_name, condition, run_results in finished_runs:
+                        results[None, camera_name, condition] = run_results
+                        for size in also:  # (written by the unit, read back here)
+                            results[size, camera_name, condition] = read_results(run_dirs[size, camera_name, condition]
+                                                                                 / "results.json")
+                    done += n_scenes * len(finished_runs)
+                    if progress:
+                        progress(done, total, f"{'+'.join(name for name, _, _ in finished_runs)} · {finished_runs[0][1]}")
 
-        in_process = runs_in_process(workers, scheduler)
+            tables = {size: _write_sweep(folders[size], collection, cameras, conditions, detectors[size],
+                                         {k[1:]: r for k, r in results.items() if k[0] == size},
+                                         {k[1:]: d for k, d in run_dirs.items() if k[0] == size}, reused,
+                                         seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, backend=backend,
+                                         subset=subset, exposure=exposure)
+                      for size in folders}
+            return tables[None]
+    except BaseException:
+        for folder in locked:  # (never a folder another sweep holds)
+            _remove_if_unused(folder, made[folder])
+        raise
 
-        def scene_progress(label: str, n_cameras: int):
-            # (runs computed here report each scene; ``done`` is read when called: the runs before them)
-            return (lambda d, t: progress(done + d * n_cameras, total, label)) if progress and in_process else None
 
-        def captures(camera, condition: str) -> Path | None:
-            if captures_from is None:
-                return None
-            return captures_for(Path(captures_from) / "runs" / run_names[camera.name, condition],
-                                camera, condition, collection, seed)
+def _remove_if_unused(folder: Path, made: list[Path]) -> None:
+    """What a sweep that failed before it wrote any run leaves of ``folder``: its empty
+    ``runs/``, its stamp where nothing else is there, and the folders it created (``made``,
+    innermost first) where empty. A folder that holds a run, a stage or a table is kept."""
+    from metricscenes.outputs import SWEEP_STAMP
 
-        # One unit per condition and group of cameras: each scene is read once per unit, and once
-        # per pixel grid resampled; as many groups as the backend runs units at once.
-        luminances = {} if in_process else shared_group_luminances(
-            collection, sorted({c for _, c in todo}), workers=workers, scheduler=scheduler)
-        jobs = []
-        for condition in conditions:
-            pending = [camera for camera, c in todo if c == condition]
-            # (a running cluster's size is its own business: there, one group per pixel grid)
-            n_groups = 1 if in_process else len(pending) if is_remote(scheduler) else max(1, workers)
-            for group in camera_groups(pending, n_groups):
-                label = f"{'+'.join(c.name for c in group)} · {condition}"
-                jobs.append((collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
-                             seed, save_images, backend, n_resamples, scene_progress(label, len(group)),
-                             [captures(c, condition) for c in group],
-                             {size: [run_dirs[size, c.name, condition] for c in group] for size in also},
-                             luminances.get(condition)))
-        with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
-            for finished_runs in finished:  # in the order they finish
-                for camera_name, condition, run_results in finished_runs:
-                    results[None, camera_name, condition] = run_results
-                    for size in also:  # (written by the unit, read back here)
-                        results[size, camera_name, condition] = read_results(run_dirs[size, camera_name, condition]
-                                                                             / "results.json")
-                done += n_scenes * len(finished_runs)
-                if progress:
-                    progress(done, total, f"{'+'.join(name for name, _, _ in finished_runs)} · {finished_runs[0][1]}")
-
-        tables = {size: _write_sweep(folders[size], collection, cameras, conditions, detectors[size],
-                                     {k[1:]: r for k, r in results.items() if k[0] == size},
-                                     {k[1:]: d for k, d in run_dirs.items() if k[0] == size}, reused,
-                                     seed=seed, n_resamples=n_resamples, mtf_source=mtf_source, backend=backend,
-                                     subset=subset, exposure=exposure)
-                  for size in folders}
-        return tables[None]
-
+    for remove in (lambda: (folder / "runs").rmdir(),
+                   lambda: [p.name for p in folder.iterdir()] == [SWEEP_STAMP] and (folder / SWEEP_STAMP).unlink(),
+                   *(p.rmdir for p in made)):
+        try:
+            remove()
+        except OSError:
+            return
 
 def _write_sweep(out_dir: Path, collection, cameras: list, conditions: list[str], detector, results: dict,
                  run_dirs: dict, reused: set, *, seed: int, n_resamples: int, mtf_source: str, backend: str,
