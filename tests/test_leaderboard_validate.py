@@ -458,6 +458,40 @@ def test_in_memory_submissions_checked_too(world, edit, expected):
     assert str(info.value).startswith("good: ") and expected in str(info.value) and "\n" not in str(info.value)
 
 
+def _laughs(levels: int) -> str:
+    """A protocols.yaml whose description is 9**levels strings made of aliases of aliases."""
+    lines = ["a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+    lines += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, levels + 1)]
+    return ("laughs:\n" + "".join(f"  {line}\n" for line in lines)
+            + PROTOCOLS.format(sha="0" * 64).replace("description: smoke", f"description: *a{levels}"))
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    (_laughs(6), "invalid protocols file (an alias (*name): a protocols file holds none at line 3)"),
+    (PROTOCOLS.format(sha="0" * 64) + "accepted_by: me\n",
+     "invalid protocols file (unknown top-level key(s) accepted_by (it holds only 'protocols'))"),
+    (PROTOCOLS.format(sha="0" * 64).replace("n_environments", "n_environment"),
+     "invalid protocols file (protocol 'smoke': unknown key(s) n_environment"),
+    (PROTOCOLS.format(sha="0" * 64).replace("description: smoke", "description: [a, b]"),
+     "invalid protocols file (protocol 'smoke': description must be a string, got list)"),
+])
+def test_a_protocols_file_a_pull_request_can_carry_is_read_as_untrusted(app, world, tmp_path, text, expected):
+    """A leaderboard's own protocols.yaml: no aliases (a "billion laughs" grew to a MemoryError
+    when its description was printed), no key that would be ignored, strings where strings
+    are meant; each one line, at once."""
+    import time
+
+    lb = tmp_path / "lb"
+    (lb / "submissions").mkdir(parents=True)
+    (lb / "protocols.yaml").write_text(text)
+    path = tmp_path / "good.json"
+    path.write_text(dumps_submission(world["good"]))
+    started = time.perf_counter()
+    res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", lb])
+    assert res.exit_code == 2 and len(stderr.strip().splitlines()) == 1 and expected in stderr, stderr
+    assert time.perf_counter() - started < 10
+
+
 def test_check_name_is_anchored_at_the_very_end():
     from benchmark.leaderboard import SubmissionError, check_name
 
