@@ -273,6 +273,17 @@ BAD = [
     ("no-mtf50-for-a-spec-with-a-group", _edit(lambda s: s["camera"].update(mtf50_source="none", mtf50_cy_per_mm=None)),
      "good.json", "camera.mtf50_source is 'none', but the spec has a published MTF50 group"),
     ("detections-of-another-entry", lambda good: b"", "good.json", "is the detections of existing.json"),  # made in the test
+    # fields that passed --check where no duplicate answered first
+    ("collection-name-of-another-protocol", _edit(lambda s: s["collection"].update(name="metric-300")), "good.json",
+     "collection.name 'metric-300' is not the name of protocol 'smoke''s collection ('smoke')"),
+    ("package-version-no-release-has", _edit(lambda s: s.update(package_version="999")), "good.json",
+     "package_version 999 is newer than this checker's metricscenes"),
+    ("package-version-not-a-version", _edit(lambda s: s.update(package_version="latest")), "good.json",
+     "package_version 'latest' is not a version (PEP 440"),
+    ("created-before-the-protocol", _edit(lambda s: s.update(created_at="1900-01-01T00:00:00Z")), "good.json",
+     "created_at 1900-01-01T00:00:00Z is before 2023-01-01"),
+    ("od50-sd-astronomical", _edit(lambda s: s["conditions"]["day"].update(od50_sd_m=1e300)), "good.json",
+     "conditions.day.od50_sd_m = 1e+300 m is beyond any OD50 an AP curve gives"),
 ]  # fmt: skip
 
 

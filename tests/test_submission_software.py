@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from benchmark.cli.main import app
@@ -29,13 +30,33 @@ def test_the_same_software_is_no_difference_and_validates():
     assert software_differences(json.loads(REFERENCE.read_text())) == []  # made before it was recorded: silent
 
 
+@pytest.mark.parametrize(("versions", "expected"), [
+    ({}, "software.versions is empty"),
+    ({"numpy": None}, "software.versions.numpy is None, not a version"),
+    ({"numpy": "two"}, "software.versions.numpy is 'two', not a version"),
+    ({"x" * 5000: "1.0"}, "software.versions names 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx'..., not a package that decides"),
+])
+def test_software_that_no_run_records_is_refused(tmp_path, versions, expected):
+    """A run records every byte-deciding package's version (each is a dependency): none of these
+    comes from one, and a package name is printed back at most 40 characters long."""
+    path = tmp_path / "ref-cam12-yolov5n-quick.json"
+    path.write_text(json.dumps(_with_software(versions, isa_class())))
+    res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(tmp_path / "lb")])
+    assert res.exit_code == 2 and expected in res.output and len(res.output) < 400, res.output
+
+
 def test_check_warns_about_other_versions_and_another_kernel_class(tmp_path):
     other_isa = "avx512" if isa_class() != "avx512" else "avx2"
     sub = _with_software({**package_versions(), "numpy": "1.0.0"}, other_isa)
-    assert software_differences(sub) == [f"numpy 1.0.0 (here {package_versions()['numpy']})",
+    assert software_differences(sub) == [f"made with numpy 1.0.0 (here {package_versions()['numpy']})",
                                          f"made on an x86-64 {other_isa} machine (here {isa_class()})"]
     path = tmp_path / "ref-cam12-yolov5n-quick.json"
     path.write_text(json.dumps(sub))
     res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(tmp_path / "lb")])
     assert res.exit_code == 0, res.output
     assert "warning: ref-cam12-yolov5n-quick.json was made with numpy 1.0.0" in res.output
+    assert f"(here {package_versions()['numpy']}) and made on an x86-64 {other_isa} machine" in res.output
+    sub["software"] = {"versions": package_versions(), "isa_class": other_isa}  # the machine alone: no "made with made on"
+    path.write_text(json.dumps(sub))
+    res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(tmp_path / "lb")])
+    assert res.exit_code == 0 and f"quick.json was made on an x86-64 {other_isa} machine" in res.output, res.output

@@ -50,7 +50,7 @@ def submit(
             typer.echo(f"ok: {check.name} (protocol {data['collection']['protocol']}, conditions {conditions}{recomputed})")
             differences = software_differences(data)
             if differences:  # a reproduction here need not give the same bytes (docs/performance.md)
-                typer.echo(f"warning: {check.name} was made with {'; '.join(differences)}: a rerun here may give "
+                typer.echo(f"warning: {check.name} was {' and '.join(differences)}: a rerun here may give "
                            "other bytes (AP within about 0.015 per distance)", err=True)
             return
         if results_dir is None or name is None:

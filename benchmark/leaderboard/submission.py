@@ -219,15 +219,17 @@ def build_submission(
 
 def software_differences(submission: dict) -> list[str]:
     """How this machine differs from the one that made a submission's runs, in what decides
-    bytes (versions, kernel class); empty where it does not or the submission does not say."""
+    bytes, as phrases: "made with numpy 1.0.0 (here 2.1.3), scipy ..." and "made on an x86-64
+    avx512 machine (here avx2)"; empty where it does not or the submission does not say."""
     from metricscenes.numeric_pins import isa_class, package_versions
 
     software = submission.get("software")
     if not software:
         return []
     here = package_versions()
-    out = [f"{name} {made} (here {here.get(name)})" for name, made in sorted(software["versions"].items())
-           if here.get(name) != made]
+    versions = [f"{name} {made} (here {here.get(name)})" for name, made in sorted(software["versions"].items())
+                if here.get(name) != made]
+    out = [f"made with {', '.join(versions)}"] if versions else []
     if software["isa_class"] != isa_class():
         out.append(f"made on an x86-64 {software['isa_class']} machine (here {isa_class()})")
     return out

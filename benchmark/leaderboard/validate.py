@@ -4,16 +4,19 @@ Each refusal is a :class:`SubmissionError` with a one-line reason. The checks be
 schema: no string holds a control character, line break, lone surrogate or invisible
 formatting character (a right-to-left override, a zero-width space) and no number is
 infinite (:func:`benchmark.leaderboard.schema.check_values`); no name is blank or padded
-with spaces; ``created_at`` is a real date, not in the future; the camera spec's sha256
+with spaces; ``created_at`` is a real date, not in the future nor before the protocol's
+paper (2023); ``package_version`` is a version no newer than the checker's; ``software``
+names byte-deciding packages with their versions; the camera spec's sha256
 matches its content, and a measured or analytic MTF50 is the one its spec gives; the
 detector is what ``benchmark run`` records (a registry model's name, sha256, family and
 licence together, an input-size policy, AP's score threshold 0.001, multi-label); the
-protocol and manifest hash are accepted (:mod:`benchmark.leaderboard.protocols`); every
+protocol and manifest hash are accepted (:mod:`benchmark.leaderboard.protocols`) and the
+collection has the protocol's collection name; every
 condition has exactly the protocol's distances, one image per environment at each, the
 protocol's number of environments and its own detections file, and the required conditions
 are there; AP never exceeds AP50; OD50 follows from the AP curve
 (:func:`benchmark.scoring.od50`) and lies inside its ordered 95 % interval, whose SD is 0
-only if it has no width; the name is new on the leaderboard, and so are the system (camera
+only if it has no width, none of them above :data:`MAX_OD50_M`; the name is new on the leaderboard, and so are the system (camera
 spec, detector, collection: a reproduction is not a second row) and its detections; and,
 given the detections file and ground truth, AP recomputed with
 :func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
@@ -41,6 +44,8 @@ NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
 AP_TOLERANCE = 1e-6
 OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
 CLOCK_TOLERANCE = timedelta(days=1)  # created_at may be this far ahead of the checker's clock
+EARLIEST_CREATED_AT = datetime(2023, 1, 1, tzinfo=timezone.utc)  # the protocol's paper (Liu et al., EI 2023)
+MAX_OD50_M = 1e9  # beyond any extrapolated OD50 of a real AP curve (the committed ones reach 3e5 m)
 SUBMISSIONS = "submissions"
 
 
@@ -167,6 +172,44 @@ def _spec_mtf50(spec, kind: str) -> tuple[float, str]:
     return _MTF50_CACHE[key]
 
 
+def _check_package_version(text: str, source: str) -> None:
+    """``package_version`` is a PEP 440 version no newer than the checker's own metricscenes
+    (a submission is made by a released version or this one, and the leaderboard is checked
+    with the newest)."""
+    from packaging.version import InvalidVersion, Version
+
+    from metricscenes import __version__
+
+    try:
+        made = Version(text)
+    except InvalidVersion:
+        raise SubmissionError(f"{source}: package_version {text!r} is not a version (PEP 440, e.g. {__version__})") from None
+    if made > Version(__version__):
+        raise SubmissionError(f"{source}: package_version {text} is newer than this checker's metricscenes "
+                              f"{__version__}: no such version made it (or check it with that version)")
+
+
+def _check_software(software: dict, source: str) -> None:
+    """``software.versions`` names byte-deciding packages (:data:`metricscenes.numeric_pins.BYTE_DECIDING_PACKAGES`),
+    one or more, each with the version installed where the runs were made (a run needs every one of them)."""
+    from packaging.version import InvalidVersion, Version
+
+    from metricscenes.numeric_pins import BYTE_DECIDING_PACKAGES
+
+    versions = software["versions"]
+    if not versions:
+        raise SubmissionError(f"{source}: software.versions is empty (it names the versions that made the runs' bytes)")
+    for name, made in versions.items():
+        if name not in BYTE_DECIDING_PACKAGES:
+            raise SubmissionError(f"{source}: software.versions names {name[:40]!r}{'...' if len(name) > 40 else ''}, "
+                                  f"not a package that decides the bytes ({', '.join(BYTE_DECIDING_PACKAGES)})")
+        try:
+            Version(made)
+        except (InvalidVersion, TypeError):
+            raise SubmissionError(f"{source}: software.versions.{name} is {made!r}, not a version (each package "
+                                  "is installed where a run is made)") from None
+
+
 def _check_named_fields(data: dict, source: str) -> None:
     """No name is blank or starts or ends with white space ("cam12 " would pass for cam12)."""
     for path in NAMED_FIELDS:
@@ -268,6 +311,11 @@ def _check_interval(cname: str, cond: dict, source: str) -> None:
 
     lo, hi = (math.inf if v is None else float(v) for v in cond["od50_ci95_m"])
     where = f"{source}: conditions.{cname}"
+    for field, value in (("od50_m", cond["od50_m"]), ("od50_sd_m", cond["od50_sd_m"]), ("od50_ci95_m[0]", lo),
+                         ("od50_ci95_m[1]", hi)):
+        if value is not None and math.isfinite(value) and value > MAX_OD50_M:
+            raise SubmissionError(f"{where}.{field} = {value:g} m is beyond any OD50 an AP curve gives "
+                                  f"(at most {MAX_OD50_M:g} m; null stands for +inf)")
     if lo > hi:
         raise SubmissionError(f"{where}.od50_ci95_m = [{show(lo)}, {show(hi)}] is reversed (lo > hi)")
     value = math.inf if cond["od50_m"] is None else float(cond["od50_m"])
@@ -297,7 +345,13 @@ def validate_submission(
     now = datetime.now(timezone.utc) if now is None else now
     if created > now + CLOCK_TOLERANCE:
         raise SubmissionError(f"{source}: created_at {data['created_at']} is in the future (now {now:%Y-%m-%dT%H:%M:%SZ})")
+    if created < EARLIEST_CREATED_AT:
+        raise SubmissionError(f"{source}: created_at {data['created_at']} is before {EARLIEST_CREATED_AT:%Y-%m-%d}, "
+                              "before the protocol it is scored on existed (Liu et al., EI 2023)")
     _check_named_fields(data, source)
+    _check_package_version(data["package_version"], source)
+    if "software" in data:
+        _check_software(data["software"], source)
     _check_camera(data, source)
     _check_detector(data, source)
     protocols = load_protocols() if protocols is None else protocols
@@ -311,6 +365,9 @@ def validate_submission(
         raise SubmissionError(
             f"{source}: collection.manifest_sha256 {col['manifest_sha256'][:12]}... is not an accepted manifest of protocol {protocol.name!r}"
         )
+    if col["name"] not in protocol.collection_names:  # (a manifest's name is part of its sha256)
+        raise SubmissionError(f"{source}: collection.name {col['name']!r} is not the name of protocol {protocol.name!r}'s "
+                              f"collection ({', '.join(map(repr, protocol.collection_names))})")
     conditions = data["conditions"]
     for required in protocol.required_conditions:
         if required not in conditions:
