@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from metricscenes import __version__
-from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
+from metricscenes.cli_support import SCHEDULER_HELP, cannot_write, fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   help="Seeded metric driving scenes rendered as spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹).")
@@ -95,8 +95,7 @@ def generate(
     except _user_errors() as exc:
         fail(str(exc))
     except OSError as exc:  # --out unwritable, disk full: one line, the lock released
-        where = f" ({exc.filename})" if exc.filename else ""
-        fail(f"cannot write {out}{where}: {exc.strerror or type(exc).__name__}")
+        fail(cannot_write(out, exc))
 
 
 def _names(text: str | None) -> tuple[str, ...]:

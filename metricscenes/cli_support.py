@@ -29,6 +29,14 @@ def fail(message: str, code: int = 2) -> NoReturn:
     raise typer.Exit(code)
 
 
+def cannot_write(out, exc: OSError) -> str:
+    """The one line of an OSError met writing ``out`` (a full disk, a folder that is not
+    writable): the file it names where it names one, and the reason in words (an OSError
+    raised with a message only, such as shutil's on a symbolic link, keeps its message)."""
+    where = f" ({exc.filename})" if exc.filename else ""
+    return f"cannot write {out}{where}: {exc.strerror or str(exc) or type(exc).__name__}"
+
+
 class LogProgress:
     """Progress for a log file: a plain line every ``step`` of the units or every ``every_s``
     seconds, whichever comes first (units done, elapsed, estimated remaining). What

@@ -104,6 +104,6 @@ def check_file_output(path: str | Path, what: str, suffixes: tuple[str, ...]) ->
         raise OutputError(f"{what} {path}: the file name must end in {' or '.join(suffixes)}")
     if path.is_dir():
         raise OutputError(f"{what} {path} is a folder; name a file such as out{suffixes[0]}")
-    if problem := file_in_the_way(path.parent):
-        raise OutputError(problem.replace("--out", what, 1))
+    if problem := file_in_the_way(path.parent, what):
+        raise OutputError(problem)
     return check_output(path, what)

@@ -209,14 +209,15 @@ def mask_box_xywh(mask: np.ndarray, extent: TanExtent, width_px: int, height_px:
     return None if box is None else box_tan_to_xywh(box, width_px, height_px, field)
 
 
-def file_in_the_way(out_dir: str | Path) -> str | None:
-    """Why ``out_dir`` cannot be a folder (it is a file, or a path through one), or None."""
+def file_in_the_way(out_dir: str | Path, what: str = "--out") -> str | None:
+    """Why ``out_dir`` cannot be a folder (it is a file, or a path through one), or None;
+    ``what``: the option that named it."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        return f"--out {out_dir} is a file, not a folder"
+        return f"{what} {out_dir} is a file, not a folder"
     for parent in out_dir.absolute().parents:
         if parent.exists():
-            return None if parent.is_dir() else f"--out {out_dir}: {parent} is a file, not a folder"
+            return None if parent.is_dir() else f"{what} {out_dir}: {parent} is a file, not a folder"
     return None
 
 

@@ -169,6 +169,7 @@ class UnitArrays:
         attrs = radiance_attributes(light_group, extent, self.mantissa_bits,
                                     None if basis is None else basis.T.tolist(), extra_attrs)
         path = f"{kind}/{self.unit}/{light_group}"
+        self._check_own_folder(path)
         arr = zarr.create_array(
             store=str(self.root / RADIANCE_STORE), name=path, shape=stored.shape, dtype="float32", chunks=stored.shape,
             dimension_names=DIMENSIONS if basis is None else (*DIMENSIONS[:2], spectral_basis.DIMENSION),
@@ -181,12 +182,23 @@ class UnitArrays:
         self.attributes_sha256[path] = _stored_attributes_sha256(self.root, path)
         return self.sha256[path]
 
+    def _check_own_folder(self, path: str) -> None:
+        """Refuse (:class:`CollectionError`, naming it) an array folder that is a symbolic link:
+        zarr replaces an array by removing its folder, which it cannot do through a link
+        ("Cannot call rmtree on a symbolic link", no path)."""
+        folder = self.root / RADIANCE_STORE / path
+        if folder.is_symlink():
+            raise CollectionError(f"{self.root}: {RADIANCE_STORE}/{path} is a symbolic link (to {folder.readlink()}), "
+                                  "and generate writes an array only in its own folder: remove the link (the array is "
+                                  "rendered again) or put the folder it points to in its place")
+
     def write_mask(self, mask: np.ndarray, extent: TanExtent) -> str:
         """Write the car's instance mask (True = car) over the inset window; return its sha256."""
         import zarr
 
         mask = np.ascontiguousarray(mask, dtype=bool)
         path = f"masks/{self.unit}"
+        self._check_own_folder(path)
         arr = zarr.create_array(
             store=str(self.root / RADIANCE_STORE), name=path, shape=mask.shape, dtype="bool",
             chunks=mask.shape, dimension_names=("y", "x"), overwrite=True, config=WRITE_CONFIG,

@@ -412,3 +412,83 @@ def test_generate_takes_over_a_stale_lock_and_leaves_the_collection_identical(sm
     assert proc.returncode == 0, proc.stderr
     assert f"taking over the stale lock of PID {dead.pid}" in proc.stderr
     assert _snapshot(root) == before  # lock released, nothing re-rendered
+
+
+# --- messages that said too little, and a folder of other files ----------------------------
+def _fake_benchmark(monkeypatch, tmp_path):
+    """`benchmark run` and `sweep` on the fake collection and detector of test_sweep_cache."""
+    import benchmark.detectors
+    import metricscenes.store
+    from test_sweep_cache import FakeCollection, FakeDetector
+
+    monkeypatch.setattr(metricscenes.store.Collection, "open", classmethod(lambda cls, path: FakeCollection(tmp_path)))
+    monkeypatch.setattr(benchmark.detectors, "load_detector", lambda model, **kw: FakeDetector(name=model))
+
+
+def _invoked_one_line(args) -> str:
+    from typer.testing import CliRunner
+
+    from benchmark.cli.main import app
+
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    assert result.exit_code == 2 and (result.exception is None or isinstance(result.exception, SystemExit)), result.output
+    lines = error_lines(result.output)
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    return lines[0]
+
+
+def test_run_and_sweep_on_a_full_disk_name_the_folder_and_the_reason(tmp_path, monkeypatch):
+    import errno
+
+    from test_sweep_cache import patch_runs
+
+    def disk_full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    _fake_benchmark(monkeypatch, tmp_path)
+    patch_runs(monkeypatch, disk_full)
+    line = _invoked_one_line(["run", "--camera", "cam01", "--collection", tmp_path, "--out", tmp_path / "r"])
+    assert line == f"error: cannot write {tmp_path / 'r'}: No space left on device"
+    line = _invoked_one_line(["sweep", "--collection", tmp_path, "--cameras", "cam01", "--conditions", "day",
+                              "--out", tmp_path / "s", "--resamples", "20", "--mtf-source", "analytic"])
+    assert line == f"error: cannot write {tmp_path / 's'}: No space left on device"
+    assert not (tmp_path / "r").exists() and not (tmp_path / "s").exists()
+
+
+def test_also_input_size_into_a_collection_names_its_option(smoke_collection, tmp_path):
+    from conftest import require_model
+
+    require_model("yolov5n-dynamic.onnx")
+    line = _invoked_one_line(["sweep", "--collection", smoke_collection, "--cameras", "cam12", "--conditions", "day",
+                              "--out", tmp_path / "s", "--also-input-size", f"native={smoke_collection}"])
+    assert f"--also-input-size {smoke_collection} is the collection" in line and "--out" not in line
+    assert not (tmp_path / "s").exists()
+
+
+def test_score_refuses_boxes_that_are_not_finite(tmp_path):
+    from synthetic_scoring import synthetic_collection
+
+    gt, dets = synthetic_collection(n_environments=4, seed=3)
+    (tmp_path / "groundtruth.json").write_text(json.dumps(gt))
+    for bad in ([float("nan"), 1.0, 2.0, 3.0], [1.0, 1.0, float("inf"), 3.0], [1.0, 1.0, -5.0, 3.0]):
+        dets[7]["bbox"] = bad
+        (tmp_path / "detections.json").write_text(json.dumps(dets))
+        line = _invoked_one_line(["score", tmp_path])
+        assert f"detection 7 (image {dets[7]['image_id']}): bbox" in line and "must be four finite numbers" in line
+
+
+@pytest.mark.slow
+def test_a_symlinked_array_folder_is_named_with_the_reason(smoke_collection, tmp_path):
+    """generate rewrites a damaged array by removing its folder, which zarr cannot do through
+    a symbolic link: the line named neither ("cannot write …: OSError")."""
+    root = _copy(smoke_collection, tmp_path)
+    array = root / "radiance.zarr" / "plates" / "env000" / "sky_day"
+    shutil.move(array, tmp_path / "elsewhere")
+    array.symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    chunk = next(p for p in (tmp_path / "elsewhere").rglob("*") if p.is_file() and p.name != "zarr.json")
+    chunk.write_bytes(chunk.read_bytes()[:100])  # damaged: rendered again
+    proc = _run("metricscenes.cli", "generate", "--manifest", SMOKE_MANIFEST, "--out", root)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    errors = [line for line in error_lines(proc.stderr) if not line.startswith("rendering ")]  # (its notice first)
+    assert len(errors) == 1 and errors[0].startswith("error: "), proc.stderr
+    assert "radiance.zarr/plates/env000/sky_day is a symbolic link" in errors[0] and "remove the link" in errors[0]

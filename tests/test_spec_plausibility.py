@@ -132,6 +132,8 @@ def _qe_rows(change=None) -> list[str]:
      "if they are in um, write 380 to"),
     (lambda r: [r[0].replace("qe_b", "qe_blue")] + r[1:], "lacks column(s) qe_b"),
     (lambda r: r[:2], "1 row(s); two or more wavelengths are needed"),
+    (lambda r: ["Sony IMX363 quantum efficiency, from its datasheet", "see the curves in figure 3"],  # not a table
+     "not a table of wavelength_nm, qe_r, qe_g, qe_b[, qe_c][, ir_cut_transmittance] (line 2 has 1 columns, the header 2)"),
 ])
 def test_impossible_qe_tables_are_refused(tmp_path, change, expected):
     (tmp_path / "qe.csv").write_text("\n".join(_qe_rows(change)) + "\n")
@@ -141,6 +143,18 @@ def test_impossible_qe_tables_are_refused(tmp_path, change, expected):
     assert "QE table qe.csv: " in line and expected in line, line
     with pytest.raises(ValueError, match="QE table qe.csv"):
         check_qe_table(tmp_path / "qe.csv")
+
+
+@pytest.mark.parametrize("label", ["\x1b[31mred\x1b[0m", "two\nlines", "bell\x07", "zero\u200bwidth", "x" * 201])
+def test_a_label_that_would_drive_the_terminal_is_refused(tmp_path, label):
+    """`cameras show` prints the label: an ANSI escape, a line break or an invisible character
+    in it would reach the terminal as it is."""
+    spec = tmp_path / "cam.yaml"
+    spec.write_text(BASE + f"label: {json.dumps(label)}\nsensor: {{pixel_um: 1.4}}\n")
+    line = _refused_by_run(tmp_path, spec)
+    assert "label" in line and "\x1b" not in line, line
+    res = runner.invoke(app, ["cameras", "show", str(spec)])
+    assert res.exit_code == 2 and "\x1b" not in res.output and len(res.output.strip().splitlines()) == 1, res.output
 
 
 def test_the_packaged_qe_table_passes():

@@ -599,7 +599,8 @@ class CameraSpec(SpecModel):
     """One camera of the benchmark."""
 
     name: str = Field(..., pattern=r"^[A-Za-z0-9_.-]+$", max_length=64)
-    label: str = ""
+    label: str = Field("", max_length=200)
+    """Free text for people (`cameras show` and `list` print it): one line of printable characters."""
     mtf50_group_cy_per_mm: float | None = Field(None, gt=0.0, le=2000.0)
     """The MTF50 group the paper published for this camera (None for user cameras)."""
     optics: OpticsSpec
@@ -622,6 +623,16 @@ class CameraSpec(SpecModel):
     @property
     def f_number(self) -> float:
         return self.optics.f_number
+
+    @field_validator("label")
+    @classmethod
+    def _label_is_printable(cls, value: str) -> str:
+        # an ANSI escape, a line break or an invisible character would reach the terminal as it is
+        bad = next((ch for ch in value if not ch.isprintable()), None)
+        if bad is not None:
+            raise ValueError(f"holds the character U+{ord(bad):04X}, which prints as nothing or drives the terminal "
+                             "(the label is one line of printable characters)")
+        return value
 
     @model_validator(mode="after")
     def _one_acquisition(self) -> "CameraSpec":

@@ -4,6 +4,7 @@ the file, the row and the column."""
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -22,7 +23,14 @@ def read_numeric_csv(path: str | Path, what: str, columns: tuple[str, ...], *, o
             warnings.simplefilter("ignore")  # an empty or short file: refused below, one line
             table = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{what} {name}: unreadable ({str(exc).splitlines()[0]})") from None
+        # numpy's "Some errors were detected !" heads the lines that say what: the first of them
+        lines = [line.strip() for line in str(exc).splitlines() if line.strip()] or [type(exc).__name__]
+        if len(lines) > 1 and lines[0].startswith("Some errors were detected"):
+            first = re.sub(r"Line #(\d+) \(got (\d+) columns instead of (\d+)\)", r"line \1 has \2 columns, the header \3",
+                           lines[1])
+            more = f", and {len(lines) - 2} more such line(s)" if len(lines) > 2 else ""
+            raise ValueError(f"{what} {name}: not a table of {expected} ({first}{more})") from None
+        raise ValueError(f"{what} {name}: unreadable ({lines[0]})") from None
     names = table.dtype.names or ()
     missing = [c for c in columns if c not in names]
     if missing:

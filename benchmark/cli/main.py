@@ -17,7 +17,7 @@ from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.suggest import did_you_mean
-from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
+from metricscenes.cli_support import SCHEDULER_HELP, cannot_write, fail, progress_bar
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_show_locals=False,
                   rich_markup_mode=None, context_settings=HELP_SETTINGS,  # help over the terminal's width
@@ -115,8 +115,10 @@ def run(
             task = bar.add_task(f"{cam.name} · {condition}", total=len(col.scenes()))
             results = run_camera(col, cam, condition, detector, out, seed=seed, save_images=save_images,
                                  backend=backend, progress=lambda done, total: bar.update(task, completed=done))
-    except (ValueError, CollectionError, OSError) as exc:
+    except (ValueError, CollectionError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+    except OSError as exc:  # a full disk, an unwritable folder: nothing written (run_camera stages)
+        fail(cannot_write(out, exc))
     title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
@@ -207,7 +209,7 @@ def sweep(
         also = parse_also_input_sizes(also_input_size or [])
         check_pass_policies(detector, also)
         for folder in also.values():
-            check_out_dir(folder)
+            check_out_dir(folder, "--also-input-size")
             check_output(folder, "--also-input-size", own=SWEEP)
     except (ValueError, DetectorError, CollectionError) as exc:
         fail(str(exc).splitlines()[0])
@@ -223,8 +225,10 @@ def sweep(
             sweep_module.sweep(col, cams, conds, detector, out, seed=seed, n_resamples=resamples,
                                progress=progress, mtf_source=mtf_source, save_images=save_images, exposure=policy,
                                workers=workers, scheduler=scheduler, captures_from=captures_from, also=also)
-    except (ValueError, DetectorError, CollectionError, BackendError, OSError) as exc:
+    except (ValueError, DetectorError, CollectionError, BackendError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+    except OSError as exc:  # a full disk, an unwritable folder: the runs finished so far are kept
+        fail(cannot_write(out, exc))
     _, od50_table = sweep_module.load_sweep(out)
     title = (f"OD50 ± SD (m) · {detector.name} · {resamples} bootstrap resamples over environments; MTF50 in cy/mm "
              "on the sensor and cy/mrad in object space (f: focal length, mm)")

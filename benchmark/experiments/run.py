@@ -71,19 +71,20 @@ def check_path_name(name: str, what: str) -> str:
     return name
 
 
-def check_out_dir(out_dir) -> Path:
+def check_out_dir(out_dir, what: str = "--out") -> Path:
     """An output folder for benchmark: its own name follows :func:`check_path_name`, it is
     not a file nor under one, and it is not a collection nor inside one (collections are
-    read-only to benchmark)."""
+    read-only to benchmark). ``what``: the option that named it, for the message."""
     from metricscenes.store import collection_containing, file_in_the_way
 
     out_dir = Path(out_dir)
-    check_path_name(out_dir.name, "--out folder name")  # as typed: 'runs/..' and '.' name no folder
-    if problem := file_in_the_way(out_dir):
+    check_path_name(out_dir.name, f"{what} folder name")  # as typed: 'runs/..' and '.' name no folder
+    if problem := file_in_the_way(out_dir, what):
         raise ValueError(problem)
     inside = collection_containing(out_dir)
     if inside is not None:
-        raise ValueError(f"--out {out_dir} is inside the collection {inside}: collections are read-only to "
+        where = "is" if inside == Path(os.path.abspath(out_dir)).resolve() else "is inside"
+        raise ValueError(f"{what} {out_dir} {where} the collection {inside}: collections are read-only to "
                          "benchmark, choose a folder outside it")
     return out_dir
 

@@ -321,7 +321,8 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     out_dir = run_module.check_out_dir(out_dir)
     if captures_from is not None and Path(captures_from).resolve() == out_dir.resolve():
         raise ValueError(f"--captures-from {captures_from} is the sweep folder itself: name another sweep's folder")
-    also = {parse_input_size(size): run_module.check_out_dir(folder) for size, folder in (also or {}).items()}
+    also = {parse_input_size(size): run_module.check_out_dir(folder, "--also-input-size")
+            for size, folder in (also or {}).items()}
     run_module.check_pass_policies(detector, also)
     for size, folder in also.items():
         others = [out_dir, *([Path(captures_from)] if captures_from is not None else []),

@@ -84,6 +84,31 @@ def images_by_distance(groundtruth: dict) -> dict[float, list[int]]:
     return dict(sorted(groups.items()))
 
 
+def check_detections(detections: list[dict]) -> None:
+    """One-line ValueError naming the first detection whose ``bbox`` is not four finite
+    numbers with a width and height of 0 or more, or whose ``score`` is not a finite number:
+    COCO scores NaN and infinite boxes without a word (a NaN box matches nothing)."""
+    try:  # all at once; one by one only to name the first bad one
+        boxes = np.asarray([d["bbox"] for d in detections], dtype=np.float64).reshape(len(detections), 4)
+        scores = np.asarray([d["score"] for d in detections], dtype=np.float64)
+        if np.all(np.isfinite(boxes)) and np.all(boxes[:, 2:] >= 0) and np.all(np.isfinite(scores)):
+            return
+    except (TypeError, ValueError, KeyError):
+        pass
+    for k, d in enumerate(detections):
+        box, score = (d.get("bbox"), d.get("score")) if isinstance(d, dict) else (None, None)
+        try:
+            values = np.asarray(box, dtype=np.float64)
+            ok = values.shape == (4,) and bool(np.all(np.isfinite(values))) and values[2] >= 0 and values[3] >= 0
+            ok = ok and bool(np.isfinite(float(score)))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            where = f" (image {d.get('image_id')})" if isinstance(d, dict) else ""
+            raise ValueError(f"detection {k}{where}: bbox {str(box)[:80]} and score {str(score)[:24]} must be four "
+                             "finite numbers [x, y, width >= 0, height >= 0] and a finite number")
+
+
 def ap_by_distance(
     groundtruth: dict,
     detections: list[dict],
@@ -98,6 +123,7 @@ def ap_by_distance(
     categories are ignored.
     """
     _check_backend(backend)
+    check_detections(detections)
     known = {int(im["id"]) for im in groundtruth["images"]}
     unknown = sorted({int(d["image_id"]) for d in detections} - known)
     if unknown:
