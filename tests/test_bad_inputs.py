@@ -455,6 +455,18 @@ def test_run_and_sweep_on_a_full_disk_name_the_folder_and_the_reason(tmp_path, m
     assert not (tmp_path / "r").exists() and not (tmp_path / "s").exists()
 
 
+def test_run_out_into_a_folder_of_other_files_is_refused(tmp_path, monkeypatch):
+    """As generate refuses the same case: a run would write among the user's files."""
+    _fake_benchmark(monkeypatch, tmp_path)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("kept\n")
+    before = _snapshot(mine)
+    line = _invoked_one_line(["run", "--camera", "cam01", "--collection", tmp_path, "--out", mine])
+    assert f"--out {mine} holds other files (notes.txt) and is not a run folder" in line
+    assert _snapshot(mine) == before
+
+
 def test_also_input_size_into_a_collection_names_its_option(smoke_collection, tmp_path):
     from conftest import require_model
 

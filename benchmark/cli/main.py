@@ -95,12 +95,14 @@ def run(
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.camera.exposure import check_exposure_override, format_exposure, parse_exposure, with_exposure
     from benchmark.experiments.run import check_out_dir, run_camera, subset_collection
+    from benchmark.experiments.run_folder import check_run_folder
     from metricscenes.outputs import RUN, check_output
     from metricscenes.store import Collection, CollectionError
 
     try:
         check_out_dir(out)
         check_output(out, "--out", own=RUN)  # a new folder or an earlier run's, never a sweep's or the leaderboard
+        check_run_folder(out)  # nor a folder of other files
         policy = parse_exposure(exposure) if exposure is not None else None
         cam = load_camera(camera)
         check_exposure_override(cam, policy)  # before anything runs (the capture would refuse it mid-run)

@@ -25,6 +25,27 @@ STAGE_KEY = "resume-key.json"
 CHECKPOINT = "scenes.jsonl"
 
 
+RUN_FILES = ("results.json", "detections.json", "groundtruth.json", "images", IMAGE_HASHES_FILE, "od50.json")
+"""What a run writes in its folder (beside its lock and staging folders)."""
+
+
+def check_run_folder(out_dir) -> Path:
+    """``out_dir`` unless it holds files that no run wrote and is not a run folder (no
+    ``results.json``): a run would write among them (``generate`` refuses the same case).
+    What a killed run leaves (its files, lock and staging folders) is a run's."""
+    from metricscenes.lock import OUTPUT_LOCK_FILE
+
+    out_dir = Path(out_dir)
+    if not out_dir.is_dir() or (out_dir / "results.json").is_file():
+        return out_dir
+    other = sorted(p.name for p in out_dir.iterdir()
+                   if p.name not in (*RUN_FILES, OUTPUT_LOCK_FILE) and not p.name.startswith(STAGE_PREFIX))
+    if other:
+        raise ValueError(f"--out {out_dir} holds other files ({', '.join(other[:3])}{', ...' if len(other) > 3 else ''})"
+                         " and is not a run folder: choose a new or empty folder")
+    return out_dir
+
+
 def resumable_stage(out_dir: Path, key: dict) -> tuple[Path, bool]:
     """``out_dir``'s resumable staging folder and whether it is resumed: the one a run with
     the same ``key`` left (killed or interrupted), else a new one (another key's is removed)."""
