@@ -42,3 +42,18 @@ def sha256_file(path: str | Path) -> str:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def read_text_capped(path: str | Path, max_bytes: int, what: str) -> str:
+    """The UTF-8 text of a small input file (a manifest, a protocols file), read no further
+    than ``max_bytes`` + 1: a one-line ValueError for a larger file or one that is not UTF-8
+    (an OSError where it cannot be read)."""
+    path = Path(path)
+    with open(path, "rb") as f:
+        raw = f.read(max_bytes + 1)
+    if len(raw) > max_bytes:
+        raise ValueError(f"{path}: larger than {max_bytes / 2**20:g} MiB: not a {what}")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start})") from None

@@ -24,6 +24,8 @@ from typing import Annotated, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator, model_validator
 
+from metricscenes.files import read_text_capped
+
 LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "car_lights", "street_lights", "ego_lights", "ego_high_beam")
 PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights", "ego_lights", "ego_high_beam")
 """Groups that can light the background; car lamps only matter where the car is (the inset)."""
@@ -530,16 +532,11 @@ def load_manifest(path: str | Path) -> Manifest:
     """Read and validate a manifest YAML file (UTF-8, at most 1 MiB, no duplicate keys)."""
     path = Path(path)
     try:
-        with open(path, "rb") as f:
-            raw = f.read(MAX_MANIFEST_BYTES + 1)
+        text = read_text_capped(path, MAX_MANIFEST_BYTES, "manifest")
     except OSError as exc:
         raise ManifestError(f"{path}: cannot read manifest ({exc.strerror or type(exc).__name__})") from None
-    if len(raw) > MAX_MANIFEST_BYTES:
-        raise ManifestError(f"{path}: larger than {MAX_MANIFEST_BYTES // 2**20} MiB: not a manifest")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ManifestError(f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start})") from None
+    except ValueError as exc:
+        raise ManifestError(str(exc)) from None
     try:
         data = yaml.load(text, Loader=UniqueKeyLoader)
     except DuplicateKeyError as exc:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import yaml
 
+from metricscenes.files import read_text_capped
 from metricscenes.manifest import UniqueKeyLoader
 
 PROTOCOLS_FILE = "protocols.yaml"
@@ -114,14 +115,6 @@ def load_protocols(leaderboard_dir: str | Path | None = None) -> dict[str, Proto
     if leaderboard_dir is not None:
         local = Path(leaderboard_dir) / PROTOCOLS_FILE
         if local.is_file():
-            with open(local, "rb") as f:
-                raw = f.read(MAX_PROTOCOLS_BYTES + 1)
-            if len(raw) > MAX_PROTOCOLS_BYTES:
-                raise ValueError(f"{local}: larger than {MAX_PROTOCOLS_BYTES >> 20} MiB: not a protocols file")
-            try:
-                text = raw.decode("utf-8")
-            except UnicodeDecodeError as exc:
-                raise ValueError(f"{local}: not UTF-8 text (byte {exc.start})") from None
-            return _parse(text, str(local))
+            return _parse(read_text_capped(local, MAX_PROTOCOLS_BYTES, "protocols file"), str(local))
     text = resources.files("benchmark.leaderboard").joinpath("data", PROTOCOLS_FILE).read_text(encoding="utf-8")
     return _parse(text, f"benchmark/leaderboard/data/{PROTOCOLS_FILE}")
