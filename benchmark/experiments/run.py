@@ -565,7 +565,7 @@ class _CameraRun:
         from PIL import Image
 
         from benchmark.camera.pipeline import simulate
-        from benchmark.detectors import coco_category_id
+        from benchmark.coco import coco_category_id
 
         camera, captures, timings = self.camera, self.captures, self.timings
         if record is not None:
