@@ -41,9 +41,10 @@ from benchmark.camera import load_camera  # noqa: E402
 from benchmark.camera.exposure import parse_exposure, with_exposure  # noqa: E402
 from benchmark.camera.isp import encode_srgb8  # noqa: E402
 from benchmark.camera.pipeline import lens_mapping, simulate  # noqa: E402
-from benchmark.detectors import coco_category_id, load_detector  # noqa: E402
-from benchmark.experiments.run import AP_SCORE_THRESHOLD, collection_field, scene_seed, subset_collection  # noqa: E402
-from benchmark.scoring import ap_by_distance  # noqa: E402
+from benchmark.coco import coco_category_id  # noqa: E402
+from benchmark.detectors import load_detector  # noqa: E402
+from benchmark.experiments.run import collection_field, scene_seed, subset_collection  # noqa: E402
+from benchmark.scoring import AP_SCORE_THRESHOLD, ap_by_distance  # noqa: E402
 from metricscenes.photometry import image_plane_illuminance_lux  # noqa: E402
 from metricscenes.store import Collection, scale_groundtruth  # noqa: E402
 

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
+from benchmark.scoring.ap import AP_SCORE_THRESHOLD
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
     RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
@@ -48,7 +49,6 @@ from benchmark.result_files import (
 # "car" since session 12, the inset at its own resolution only around the car. Runs made before
 # it recorded none, so a sweep does not take them for this composite's.
 COMPOSITE = "car"
-AP_SCORE_THRESHOLD = 0.001  # COCO evaluation wants the whole precision-recall curve
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.
 FORBIDDEN_IN_NAMES = ("..", "/", "\\", "\0", "\n", "\r")
@@ -565,7 +565,7 @@ class _CameraRun:
         from PIL import Image
 
         from benchmark.camera.pipeline import simulate
-        from benchmark.detectors import coco_category_id
+        from benchmark.coco import coco_category_id
 
         camera, captures, timings = self.camera, self.captures, self.timings
         if record is not None:

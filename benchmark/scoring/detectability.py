@@ -14,8 +14,7 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-from benchmark.detectors.base import COCO80_NAMES, coco80_class_id
-from benchmark.detectors.nms import box_iou
+from benchmark.coco import COCO80_NAMES, box_iou, coco80_class_id
 
 CAR_CATEGORY_ID = 3
 

@@ -4,7 +4,8 @@ range, SNR at a stated reference, the figures of an EMVA 1288 report measured on
 model's photon transfer (dynamic range, SNR10 and SNR1 illuminance, HDR transitions), and
 warnings where the spec hides something (a well the gain makes unreachable, a value
 outside what most sensors have). ``benchmark cameras show`` prints them (docs/camera.md,
-"Field of view and geometry", "What a spec implies", "Datasheet figures").
+"Field of view and geometry", "What a spec implies", "Datasheet figures"). It stands in
+``measure``, above the camera, because its MTF50 and datasheet are measurements.
 
 Every figure is computed from the spec with the pipeline's own formulas: saturation by
 :func:`benchmark.camera.sensor.saturation_electrons`, the reference signal by
