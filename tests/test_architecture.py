@@ -1,4 +1,4 @@
-"""The house's walls, read from the source (issue 12): ``metricscenes`` never imports
+"""The house's walls, read from the source: ``metricscenes`` never imports
 ``benchmark``; ``benchmark`` reaches ``metricscenes`` only through the store API and
 the value and unit modules, never through its render, generate, writer, scene or asset
 internals; the store's read side never imports its write side."""

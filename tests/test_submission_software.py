@@ -1,5 +1,5 @@
 """A submission says what decided its bytes (versions, the CPU's kernel class), and
-``submit --check`` warns where this machine differs (issue 24, point 1)."""
+``submit --check`` warns where this machine differs."""
 
 from __future__ import annotations
 
