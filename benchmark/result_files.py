@@ -152,7 +152,7 @@ class RunResults(Record):
     subset: Subset | None = None
     exposure_short_s: dict[str, float] | None = None  # hdr only: the short frames per scene id
     captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
-    composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before session 12
+    composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before v0.1.0a5
     condition_weights: dict[str, dict] | None = None  # a targeted condition: per scene, target and weights (metricscenes.targets)
     numerics: dict | None = None  # versions, ISA class and kernels that decided the bytes (metricscenes.numeric_pins)
 

@@ -88,7 +88,7 @@ def test_paper_parity_night_is_below_day_everywhere(paper_parity):
     assert paper_findings(*paper_parity)["night_below_day"]
 
 
-# --- issue 23: the paper's night (0.1-1 lux image-plane, every lamp on; reference sweep) ----
+# --- the paper's night (0.1-1 lux image-plane, every lamp on; reference sweep) -------------
 
 PAPER_NIGHT_IS_READ_NOISE_BOUND = (
     "At the paper's night's own image-plane lux our camera is read-noise bound (6.8 e- on the car "
@@ -121,7 +121,7 @@ def test_paper_night_ap_at_25_m_is_useful_for_ten_cameras(tables):
     assert paper_night_findings(*tables)["night_ap_near_useful"]
 
 
-# --- issue 10: dusk and the regulation road (night_regulation; reference sweep) ------------
+# --- dusk and the regulation road (night_regulation; reference sweep) ---------------------
 
 NIGHT_IS_BLIND = (
     "On the regulation road (ego low beams to SAE J1383 / ECE R112, R7 tail lamps, R3 reflectors, "

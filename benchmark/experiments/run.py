@@ -46,8 +46,8 @@ from benchmark.result_files import (
 )
 
 # How the collection's layers are composited for a camera (metricscenes.store.Collection.radiance):
-# "car" since session 12, the inset at its own resolution only around the car. Runs made before
-# it recorded none, so a sweep does not take them for this composite's.
+# "car" since v0.1.0a5 (CHANGELOG.md), the inset at its own resolution only around the car. Runs made
+# before it recorded none, so a sweep does not take them for this composite's.
 COMPOSITE = "car"
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.

@@ -210,7 +210,7 @@ def build_submission(
     }  # fmt: skip
     if notes:
         submission["notes"] = notes
-    if first.numerics is not None:  # runs made since session 12 say what decided their bytes
+    if first.numerics is not None:  # runs made since v0.1.0a5 say what decided their bytes
         submission["software"] = {"versions": first.numerics["versions"], "isa_class": first.numerics["isa_class"]}
     if spec.sha256() != first.camera.spec_sha256:
         raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")

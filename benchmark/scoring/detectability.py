@@ -1,5 +1,5 @@
 """Is the car found? Per-distance detection rates at a working threshold, and what
-the detector mistakes the car for (DESIGN §4; the scene issue's acceptance).
+the detector mistakes the car for (DESIGN §4; docs/scenes.md, "Detectability").
 
 Unlike AP, which sweeps every threshold, this answers the practical question at one
 operating point: is there a ``car`` detection with score ≥ ``score_threshold`` whose
