@@ -33,7 +33,7 @@ mkdir -p "$DATA_OUT" "$RESULTS"
 SWEEP=(--no-save-images --resamples 1000 --seed 0 --workers 2)
 # verify and the sweeps keep their large arrays in the heap (same bytes, less CPU time; the
 # file says why). Not generate: the audit behind it did not cover the renderer (docs/performance.md).
-mapfile -t HEAP_MALLOC < <(grep -v '^#' benchmarks/heap-malloc.env)
+mapfile -t HEAP_MALLOC < <(grep -v '^#' benchmarks/metric-300/heap-malloc.env)
 # timed STEP COMMAND...: the command, then "== STEP (this sitting): N s wall" (a resumed step counts its sitting only)
 timed() { local step=$1 t0; shift; t0=$(date +%s); echo "== $(date -u +%FT%TZ) $*"; "$@"; echo "== $step (this sitting): $(( $(date +%s) - t0 )) s wall"; }
 

@@ -9,7 +9,7 @@ their ratios (a baseline in the same run: these machines are noisy); then the on
 50 and 100 m, whose windows differ: with the window's numbers opaque, a new window costs a
 render, not a compilation.
 
-    python benchmarks/bench_light_groups.py [manifests/quick.yaml] [--variant llvm_ad_spectral]
+    python benchmarks/timing/bench_light_groups.py [manifests/quick.yaml] [--variant llvm_ad_spectral]
         [--distance 25]
 """
 

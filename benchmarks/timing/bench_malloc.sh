@@ -2,19 +2,19 @@
 # What a sweep spends giving its large arrays back to the kernel: the same small sweep with
 # glibc's default (every block over 32 MB is mmap'ed and unmapped when freed, so each new
 # array is page-faulted in and zeroed by the kernel again) and with large blocks kept in the
-# heap for reuse (benchmarks/heap-malloc.env, what metric300_chain.sh sweeps with), alternated
+# heap for reuse (benchmarks/metric-300/heap-malloc.env, what the metric-300 chain sweeps with), alternated
 # twice; prints user, system and wall seconds, minor page faults and peak RSS of each, the
 # ratio of their CPU times, and whether the two settings' detections are byte-identical
 # (they must be: only where the memory comes from differs). Results: docs/performance.md, "Large arrays kept in the heap".
 #
-#   bash benchmarks/bench_malloc.sh /work/collections/metric-300-first2 cam08,cam12,cam05 day
+#   bash benchmarks/timing/bench_malloc.sh /work/collections/metric-300-first2 cam08,cam12,cam05 day
 set -euo pipefail
 COLLECTION=${1:?usage: bench_malloc.sh COLLECTION [CAMERAS] [CONDITION]}
 CAMERAS=${2:-cam08,cam12,cam05}
 CONDITION=${3:-day}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
-mapfile -t HEAP < <(grep -v '^#' "$(dirname "$0")/heap-malloc.env")  # the chain's setting
+mapfile -t HEAP < <(grep -v '^#' "$(dirname "$0")/../metric-300/heap-malloc.env")  # the chain's setting
 for round in 1 2; do
   for setting in default heap; do
     rm -rf "$OUT/$setting"

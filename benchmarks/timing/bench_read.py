@@ -2,7 +2,7 @@
 for its scenes (``Collection`` keeps the last plate it mixed) against a fresh ``Collection``
 per scene (every scene mixes its plate anew: the baseline).
 
-    PYTHONPATH=. python benchmarks/bench_read.py --collection collections/quick --scenes 12 --conditions day night
+    PYTHONPATH=. python benchmarks/timing/bench_read.py --collection collections/quick --scenes 12 --conditions day night
 
 Every array is read and checked once before the timings (the sha256 checks are cached per
 process either way), so both sides time reading, decoding and mixing. Prints seconds per

@@ -1,6 +1,6 @@
 """Time the camera simulation, stage by stage, against the previous implementation.
 
-    PYTHONPATH=. python benchmarks/bench_camera.py [--cameras cam10 cam08] [--repeat 3]
+    PYTHONPATH=. python benchmarks/timing/bench_camera.py [--cameras cam10 cam08] [--repeat 3]
 
 The input is a realistic two-layer scene: a 480 × 270 31-band plate over the whole
 field of view and a 300 × 200 inset at 0.114 mrad per pixel (the generator's inset

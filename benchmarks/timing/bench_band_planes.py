@@ -5,7 +5,7 @@ the stored (rows, cols, bands) cube becomes (bands, rows, cols) planes once per 
 script makes those planes for the layers of a few scenes both ways in one run, alternating,
 best of ``--repeat``, checks that they are identical, and prints the times and their ratio.
 
-    PYTHONPATH=. python benchmarks/bench_band_planes.py --collection /work/collections/metric-300-first2
+    PYTHONPATH=. python benchmarks/timing/bench_band_planes.py --collection /work/collections/metric-300-first2
 
 Results: docs/performance.md, "A camera run and the 13-camera sweep".
 """
@@ -19,7 +19,7 @@ import numpy as np
 
 
 def whole_view_copy(cube: np.ndarray) -> np.ndarray:
-    """band_planes before session 23: numpy's copy of the whole transposed view."""
+    """band_planes before the blocked copy: numpy's copy of the whole transposed view."""
     return np.ascontiguousarray(np.moveaxis(np.asarray(cube, dtype=np.float32), 2, 0))
 
 

@@ -6,7 +6,7 @@ frame at the inset's sampling over a strip, to extrapolate what a full frame at 
 sampling would cost. Prints times and the ratio (a baseline measured in the same run,
 since these machines are noisy).
 
-    python benchmarks/bench_generate.py [manifests/quick.yaml] [--group sky_day]
+    python benchmarks/timing/bench_generate.py [manifests/quick.yaml] [--group sky_day]
 """
 
 from __future__ import annotations

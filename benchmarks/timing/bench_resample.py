@@ -7,7 +7,7 @@ the same scenes onto the six grids both ways in one run (the baseline empties th
 store before each grid, which is what every grid did before), alternating, best of
 ``--repeat``, checks that the composites are identical, and prints the times and their ratio.
 
-    PYTHONPATH=. python benchmarks/bench_resample.py --collection collections/quick --condition night
+    PYTHONPATH=. python benchmarks/timing/bench_resample.py --collection collections/quick --condition night
 
 Results: docs/performance.md, "A camera run and the 13-camera sweep".
 """

@@ -6,7 +6,7 @@ worker start-up), checks that every run wrote the same manifest.resolved.yaml an
 groundtruth.json bytes as the 1-worker baseline, and prints wall-clock seconds and the
 ratio to that baseline (measured in the same run, since these machines are noisy).
 
-    python benchmarks/bench_backends.py [manifests/smoke.yaml] [--workers 2] [--repeat 1]
+    python benchmarks/timing/bench_backends.py [manifests/smoke.yaml] [--workers 2] [--repeat 1]
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ collection subset, in this process, and prints the wall time of each, their rati
 measured in the same run: these machines are noisy), the time per capture and per stage, and
 whether every run's detections and images are byte-identical.
 
-    PYTHONPATH=. python benchmarks/bench_sweep.py --collection collections/quick \\
+    PYTHONPATH=. python benchmarks/timing/bench_sweep.py --collection collections/quick \\
         --cameras cam07,cam10,cam12,cam08 --condition night --environments 0
 
 Results: docs/performance.md, "A camera run and the 13-camera sweep".
