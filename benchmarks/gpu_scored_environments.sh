@@ -10,7 +10,7 @@
 #   travels; the sweep's two wheels; the default detector in .gpu-models/)
 # There:        bash benchmarks/gpu_scored_environments.sh K SECONDS CAMERAS CONDITIONS
 #   e.g.        bash benchmarks/gpu_scored_environments.sh 10 540 all day,night
-# Then here:    python benchmarks/backend_scores.py ...  (compares with the CPU's runs)
+# Then here:    benchmark publish backend-scores ...  (compares with the CPU's runs)
 set -uo pipefail
 
 if [ "${1:-}" = prepare ]; then

@@ -53,9 +53,9 @@ timed sweep env "${HEAP_MALLOC[@]}" benchmark sweep --collection "$COLLECTION" -
 timed lux-sweep env "${HEAP_MALLOC[@]}" benchmark sweep --collection "$COLLECTION" --cameras cameras/lux-sweep-1.4um-f2.4.yaml \
   --conditions day@0.25lux,day@1lux,day@5lux,day@10lux,day@50lux,day@100lux,day@500lux \
   --out "$RESULTS/metric-300-lux" "${SWEEP[@]}"
-python benchmarks/mtf50_groups.py --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
+benchmark publish mtf50-groups --sweep "$RESULTS/metric-300" --conditions day,dusk,night \
   --out "$DATA_OUT/mtf50-groups.csv"
-python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+benchmark publish sweeps --results "$RESULTS" --collection metric-300 \
   --out "$DATA_OUT"
 benchmark report "$RESULTS/metric-300" "$RESULTS/metric-300-lux" --out "$WORK/reports/metric-300.html"
 # The 13 reference submissions, into a leaderboard folder of WORK's (copied to leaderboard/ by hand).
@@ -69,6 +69,6 @@ for camera in $cameras; do
 done
 timed day-paper-sweep env "${HEAP_MALLOC[@]}" benchmark sweep --collection "$COLLECTION" --cameras "$CAMERAS" --conditions day_paper \
   --out "$RESULTS/metric-300-day-paper" "${SWEEP[@]}"
-python benchmarks/results_tables.py publish --results "$RESULTS" --collection metric-300 \
+benchmark publish sweeps --results "$RESULTS" --collection metric-300 \
   --out "$DATA_OUT"
 echo "== $(date -u +%FT%TZ) metric-300 chain done"

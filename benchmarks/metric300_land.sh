@@ -43,7 +43,7 @@ cmp "$first/README.md" "$LEADERBOARD/README.md" && cmp "$first/index.html" "$LEA
 echo "leaderboard: two builds byte-identical"
 rm -r "$first"
 
-python benchmarks/results_tables.py markdown --data "$DATA" --against docs/data > "$WORK/results-markdown.md"
+benchmark publish markdown --data "$DATA" --against docs/data > "$WORK/results-markdown.md"
 echo "markdown of the tables beside quick's: $WORK/results-markdown.md"
 [ "$DATA" = docs/data/metric-300 ] && python -m pytest -q tests/test_metric300_findings.py
 echo "landed; now: docs/results.md leads with metric-300, docs/performance.md the chain's '== STEP' times"

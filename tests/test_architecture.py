@@ -53,3 +53,12 @@ def test_the_read_side_never_imports_the_write_side():
     found = _imports("metricscenes")
     offenders = {f: sorted(found[f] & write_side) for f in ("metricscenes/store.py", "metricscenes/records.py")}
     assert {f: n for f, n in offenders.items() if n} == {}
+
+
+def test_only_the_command_line_imports_the_publishing_layer():
+    """``benchmark.publish`` (what the docs publish) sits on top of experiments, scoring and the
+    cameras; below it nothing reaches up into it."""
+    offenders = {f: sorted(n for n in names if n.split(".")[:2] == ["benchmark", "publish"])
+                 for f, names in _imports("benchmark").items()
+                 if not f.startswith(("benchmark/publish/", "benchmark/cli/"))}
+    assert {f: n for f, n in offenders.items() if n} == {}

@@ -1,25 +1,22 @@
 """The same collection rendered by two backends (a CUDA GPU's and a CPU's), scored by the same
 sweep: does either give other scores than the other, beyond their bootstrap SD?
+(docs/data/backend-scores.csv; ``benchmark publish backend-scores``.)
 
 Both collections hold the same scenes (the same manifest and seeds), so each camera's two runs
 are paired scene by scene: ``benchmark compare`` resamples the environments for both at once
 (each camera against itself). Beside the paired ΔOD50 the table gives each run's own bootstrap
 OD50 SD, the scale a reader of one collection sees. Where only some of a sweep's runs finished
-on one side, the cameras both hold are compared.
-
-    PYTHONPATH=. python benchmarks/backend_scores.py --cpu /work/results/m300-first8-cpu \\
-        --gpu /work/gpu2/sweep --conditions day --out docs/data/backend-scores.csv
-
-Prints the markdown table of docs/performance.md ("On a GPU").
+on one side, the cameras both hold are compared. The markdown is docs/performance.md's "On a GPU".
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-import pandas as pd
-from camera_variants import called_distances, delta_od50_columns, delta_od50_text, od50_text  # (benchmarks/, beside this script)
+from benchmark.publish.paired import called_distances, delta_od50_columns, delta_od50_text, od50_text
+
+HEADER = ("| condition | camera | OD50 GPU (m) | OD50 CPU (m) | own SD GPU / CPU (m) | ΔOD50 GPU − CPU ± SD [95 %] (m) | "
+          "largest \\|ΔAP\\| | ΔAP called at (m) |\n|---|---|---|---|---|---|---|---|")
 
 
 def finished_cameras(sweep: Path, condition: str) -> set[str]:
@@ -48,29 +45,3 @@ def compare_backends(gpu: Path, cpu: Path, condition: str, n_resamples: int, see
                      f"{own[0]:.0f} / {own[1]:.0f} | {delta_od50_text(result)} | {largest:.3f} | "
                      f"{called or 'none'} |")
     return rows, lines
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cpu", required=True, type=Path, help="sweep folder on the CPU's collection (B)")
-    parser.add_argument("--gpu", required=True, type=Path, help="sweep folder on the GPU's collection (A)")
-    parser.add_argument("--conditions", default="day")
-    parser.add_argument("--resamples", type=int, default=1000)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, help="CSV of the table")
-    args = parser.parse_args()
-    rows, lines = [], []
-    for condition in args.conditions.split(","):
-        more_rows, more_lines = compare_backends(args.gpu, args.cpu, condition, args.resamples, args.seed)
-        rows += more_rows
-        lines += more_lines
-    if args.out:
-        pd.DataFrame(rows).to_csv(args.out, index=False, float_format="%.4f")
-    print("| condition | camera | OD50 GPU (m) | OD50 CPU (m) | own SD GPU / CPU (m) | ΔOD50 GPU − CPU ± SD [95 %] (m) | "
-          "largest \\|ΔAP\\| | ΔAP called at (m) |")
-    print("|---|---|---|---|---|---|---|---|")
-    print("\n".join(lines))
-
-
-if __name__ == "__main__":
-    main()

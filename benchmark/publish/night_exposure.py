@@ -1,8 +1,6 @@
 """What a camera collects from the car at night: exposure time, electrons on the car body,
-and what sets the exposure (the central region's brightest pixels).
-
-    PYTHONPATH=. python benchmarks/night_exposure.py --collection collections/quick \\
-        --cameras cam12 cam08 --condition night [--exposure percentile:50] --out docs/data/night-exposure.csv
+and what sets the exposure (the central region's brightest pixels): docs/data/night-exposure.csv
+and night-exposure-regulation.csv (``benchmark publish night-exposure``).
 
 For every scene the camera simulation runs without temporal noise; per scene it writes
 the car's heading, the exposure time (ms), the median signal electrons of the green pixels inside the car's
@@ -14,7 +12,6 @@ log10 electrons in the central region is drawn for a few scenes (``--histograms`
 
 from __future__ import annotations
 
-import argparse
 import csv
 from pathlib import Path
 
@@ -23,8 +20,7 @@ import numpy as np
 from benchmark.camera.pipeline import simulate
 from benchmark.camera import load_camera
 from benchmark.camera.exposure import central_region, parse_exposure, with_exposure
-from metricscenes.groundtruth import scale_groundtruth
-from metricscenes.store import Collection
+from metricscenes.store import Collection, scale_groundtruth
 
 
 def green_sites(electrons: np.ndarray, rows: slice, cols: slice) -> np.ndarray:
@@ -86,41 +82,32 @@ def scene_rows(collection: Collection, camera, condition: str) -> list[dict]:
     return out
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--collection", required=True)
-    parser.add_argument("--cameras", nargs="+", default=["cam12"])
-    parser.add_argument("--condition", default="night")
-    parser.add_argument("--exposure", default=None, help="an acquisition policy, as `benchmark run --exposure`")
-    parser.add_argument("--out", type=Path, required=True)
-    parser.add_argument("--histograms", type=Path, default=None,
-                        help="also draw central-region histograms of these scenes' first camera (PNG)")
-    parser.add_argument("--scenes", nargs="+", default=["env000-d025m", "env000-d100m", "env001-d025m", "env001-d100m"])
-    args = parser.parse_args()
-    collection = Collection.open(args.collection)
+def night_exposure(collection: Collection, cameras: list[str], condition: str, exposure: str | None = None,
+                   say=print) -> list[dict]:
+    """:func:`scene_rows` of every camera (``exposure``: an acquisition policy replacing each
+    camera's own, as ``benchmark run --exposure``); ``say`` gets each camera's medians per
+    heading and distance."""
     rows = []
-    if args.histograms:
-        central_histograms(collection, load_camera(args.cameras[0]), args.condition, args.scenes, args.histograms)
-    for name in args.cameras:
+    for name in cameras:
         camera = load_camera(name)
-        if args.exposure:
-            camera = with_exposure(camera, parse_exposure(args.exposure))
-        rows += scene_rows(collection, camera, args.condition)
+        if exposure:
+            camera = with_exposure(camera, parse_exposure(exposure))
+        rows += scene_rows(collection, camera, condition)
         groups: dict[tuple, list[dict]] = {}
         for r in rows:
             if r["camera"] == name:
                 groups.setdefault((r["heading"], r["distance_m"]), []).append(r)
         for (head, d), rs in sorted(groups.items()):
-            print(f"{name} {args.condition} {head:8s} {d:5.0f} m: exposure {np.median([r['exposure_ms'] for r in rs]):7.3f} ms, "
-                  f"car {np.median([r['car_median_e'] for r in rs]):8.2f} e-, "
-                  f"peak/median {np.median([r['peak_over_median'] for r in rs]):8.1f}")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as f:
+            say(f"{name} {condition} {head:8s} {d:5.0f} m: exposure {np.median([r['exposure_ms'] for r in rs]):7.3f} ms, "
+                f"car {np.median([r['car_median_e'] for r in rs]):8.2f} e-, "
+                f"peak/median {np.median([r['peak_over_median'] for r in rs]):8.1f}")
+    return rows
+
+
+def write_rows(rows: list[dict], out: Path) -> None:
+    """``rows`` as a CSV, columns in the first row's order."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with open(out, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    print(f"wrote {args.out}")
-
-
-if __name__ == "__main__":
-    main()

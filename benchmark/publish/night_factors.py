@@ -1,7 +1,5 @@
-"""What separates our night from the paper's, factor by factor, at equal image-plane illuminance.
-
-    PYTHONPATH=. python benchmarks/night_factors.py --collection collections/quick \\
-        --cameras cameras/lux-sweep-1.4um-f2.4.yaml cam12 --distances 25,50,100 --out docs/data/night-factors.csv
+"""What separates our night from the paper's, factor by factor, at equal image-plane illuminance:
+docs/data/night-factors.csv (``benchmark publish night-factors``).
 
 One camera, one set of scenes, one change at a time; every row is scored like a run (same
 detector, multiscale input, COCO AP of the car per distance) and says what the camera
@@ -26,26 +24,20 @@ noise-free electrons on the car's green pixels and on the whole frame, AP per di
 
 from __future__ import annotations
 
-import argparse
-import csv
-import sys
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parent))
-from night_exposure import green_sites  # noqa: E402
-
-from benchmark.camera import load_camera  # noqa: E402
-from benchmark.camera.exposure import parse_exposure, with_exposure  # noqa: E402
-from benchmark.camera.isp import encode_srgb8  # noqa: E402
-from benchmark.camera.pipeline import lens_mapping, simulate  # noqa: E402
-from benchmark.detectors import coco_category_id, load_detector  # noqa: E402
-from benchmark.experiments.run import AP_SCORE_THRESHOLD, collection_field, scene_seed, subset_collection  # noqa: E402
-from benchmark.scoring import ap_by_distance  # noqa: E402
-from metricscenes.photometry import image_plane_illuminance_lux  # noqa: E402
-from metricscenes.store import Collection, scale_groundtruth  # noqa: E402
+from benchmark.camera import load_camera
+from benchmark.camera.exposure import parse_exposure, with_exposure
+from benchmark.camera.isp import encode_srgb8
+from benchmark.camera.pipeline import lens_mapping, simulate
+from benchmark.detectors import coco_category_id
+from benchmark.experiments.run import AP_SCORE_THRESHOLD, collection_field, scene_seed, subset_collection
+from benchmark.publish.night_exposure import green_sites
+from benchmark.scoring import ap_by_distance
+from metricscenes.photometry import image_plane_illuminance_lux
+from metricscenes.store import Collection, scale_groundtruth
 
 LAMPS = ("car_lights", "street_lights", "ego_lights")
 
@@ -143,34 +135,20 @@ def run_variant(collection, scenes, weights: SceneWeights, base_camera, variant:
     return row
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--collection", required=True)
-    parser.add_argument("--cameras", nargs="+", default=["cameras/lux-sweep-1.4um-f2.4.yaml", "cam12"])
-    parser.add_argument("--condition", default="night", help="a targeted condition of the collection")
-    parser.add_argument("--distances", default="25,50,100", help="metres, as `benchmark run --distances`")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, required=True)
-    args = parser.parse_args()
-    collection = Collection.open(args.collection)
-    subset = subset_collection(collection, distances=args.distances)
+def night_factors(collection: Collection, cameras: list[str], detector, condition: str = "night",
+                  distances: str | None = "25,50,100", seed: int = 0, variants: list[Variant] = VARIANTS,
+                  say=print) -> list[dict]:
+    """A row per camera and variant on the scenes at ``distances`` (metres, as ``benchmark run
+    --distances``), all at the image-plane illuminance of ``condition`` (a targeted condition of the
+    collection); ``say`` gets each row as it is made."""
+    subset = subset_collection(collection, distances=distances)
     scenes = subset.scenes()
-    weights = SceneWeights(collection, args.condition)
-    detector = load_detector("yolov5n-dynamic")
+    weights = SceneWeights(collection, condition)
     rows = []
-    for name in args.cameras:
+    for name in cameras:
         base = load_camera(name)
-        for variant in VARIANTS:
-            row = run_variant(subset, scenes, weights, base, variant, detector, args.seed)
+        for variant in variants:
+            row = run_variant(subset, scenes, weights, base, variant, detector, seed)
             rows.append(row)
-            print(" | ".join(str(v) for v in row.values()), flush=True)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    print(f"wrote {args.out}")
-
-
-if __name__ == "__main__":
-    main()
+            say(" | ".join(str(v) for v in row.values()))
+    return rows

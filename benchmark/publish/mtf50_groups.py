@@ -1,25 +1,23 @@
-"""Cameras of one MTF50 group: do they detect alike? (Liu et al., EI 2023: "the object detection
-scores differed by as much as three standard deviations when the MTF50 was equal".)
+"""Cameras of one MTF50 group: do they detect alike? (docs/data/mtf50-groups.csv; ``benchmark
+publish mtf50-groups``.) Liu et al., EI 2023: "the object detection scores differed by as much as
+three standard deviations when the MTF50 was equal".
 
 The paper's 13 cameras fall into four published MTF50 groups (55, 75, 100 and 150 cy/mm;
 ``mtf50_group_cy_per_mm`` in their specs). For every pair in a group and every condition, the
 paired bootstrap of ``benchmark compare`` (the same environments resampled for both): ΔOD50
 ± SD and its 95 % interval, |ΔOD50| / SD, and the distances where a difference in AP is
 called. ΔOD50 is not measured where either OD50 is censored (outside the measured distances).
-
-    PYTHONPATH=. python benchmarks/mtf50_groups.py --sweep results/quick --conditions day,night \\
-        --out docs/data/mtf50-groups.csv
-
-Prints the markdown table of docs/results.md ("Cameras of one MTF50 group").
+The markdown is docs/results.md's "Cameras of one MTF50 group".
 """
 
 from __future__ import annotations
 
-import argparse
 import itertools
 from pathlib import Path
 
 import pandas as pd
+
+from benchmark.publish.paired import called_distances, delta_od50_columns, delta_od50_text, od50_text
 
 COLUMNS = ["condition", "group_cy_per_mm", "camera_a", "camera_b", "od50_a_m", "od50_b_m", "delta_od50_m",
            "delta_od50_sd_m", "delta_od50_ci95_lo_m", "delta_od50_ci95_hi_m", "delta_over_sd", "resolved",
@@ -39,9 +37,9 @@ def group_pairs(cameras: list[str]) -> list[tuple[float, str, str]]:
 
 
 def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: int) -> tuple[pd.DataFrame, list[str]]:
+    """(table of :data:`COLUMNS`, markdown rows) for every pair of the sweep's cameras in one group."""
     from benchmark.experiments.compare import compare_paths
     from benchmark.result_files import read_sweep_record
-    from camera_variants import called_distances, delta_od50_columns, delta_od50_text, od50_text  # (benchmarks/, beside this script)
 
     cameras = read_sweep_record(sweep / "sweep.json").cameras
     rows, lines = [], []
@@ -60,27 +58,15 @@ def compare_groups(sweep: Path, conditions: list[str], n_resamples: int, seed: i
     return pd.DataFrame(rows, columns=COLUMNS), lines
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sweep", required=True, type=Path)
-    parser.add_argument("--conditions", default="day,night")
-    parser.add_argument("--resamples", type=int, default=1000)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, help="CSV of the table")
-    args = parser.parse_args()
-    table, lines = compare_groups(args.sweep, args.conditions.split(","), args.resamples, args.seed)
-    if args.out:
-        table.to_csv(args.out, index=False, float_format="%.4f")
-    print("| condition | MTF50 group (cy/mm) | cameras A – B | OD50 A (m) | OD50 B (m) | ΔOD50 ± SD [95 %] (m) | "
-          "\\|Δ\\| / SD | ΔAP called at (m) |")
-    print("|---|---|---|---|---|---|---|---|")
-    print("\n".join(lines))
+def report(table: pd.DataFrame, lines: list[str]) -> str:
+    """The markdown table, then per condition how many measured pairs differ by more than 2 SD."""
+    out = ["| condition | MTF50 group (cy/mm) | cameras A – B | OD50 A (m) | OD50 B (m) | ΔOD50 ± SD [95 %] (m) | "
+           "\\|Δ\\| / SD | ΔAP called at (m) |",
+           "|---|---|---|---|---|---|---|---|",
+           *lines]
     measured = table.dropna(subset=["delta_over_sd"])
     for condition, part in measured.groupby("condition", sort=False):
         big = part[part["delta_over_sd"] > 2]
-        print(f"- {condition}: {len(part)} pairs with both OD50s measured, {len(big)} differ by more than 2 SD"
-              + (f" (largest {part['delta_over_sd'].max():.1f} SD)" if len(part) else ""))
-
-
-if __name__ == "__main__":
-    main()
+        out.append(f"- {condition}: {len(part)} pairs with both OD50s measured, {len(big)} differ by more than 2 SD"
+                   + (f" (largest {part['delta_over_sd'].max():.1f} SD)" if len(part) else ""))
+    return "\n".join(out)

@@ -1,25 +1,14 @@
-"""The tables of docs/results.md, made from the sweep folders rather than typed.
+"""The tables of docs/results.md, made from docs/data rather than typed (``benchmark publish markdown``).
 
-    PYTHONPATH=. python benchmarks/results_tables.py publish --results results --out docs/data
-    PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data
-    PYTHONPATH=. python benchmarks/results_tables.py publish --results results --collection metric-300 \
-        --out docs/data/metric-300
-    PYTHONPATH=. python benchmarks/results_tables.py markdown --data docs/data/metric-300 --against docs/data
-
-``publish`` copies each sweep's ``sweep.csv`` and ``od50.csv`` (folders ``COLLECTION``,
-``COLLECTION-640``, ``-native``, ``-lux``, ``-day-paper``, ``-policy-…``; default ``quick``) into
-``docs/data`` under the names the docs and tests/test_results_findings.py read (``-640``, ``-native``,
-``-illuminance``, ``-policies``; the policy tables gain an ``exposure`` column, the reference
-policy's rows coming from the reference sweep). ``markdown`` prints the tables of
-docs/results.md from those files: AP per distance with Spearman's ρ and OD50 per condition,
-the input-size comparison, the acquisition policies and the illuminance sweep (those a
-folder holds: metric-300 has no native or policy sweeps); with ``--against`` another collection's
-folder, each condition's OD50s camera by camera in both, with SDs and ranks (metric-300 against quick).
+AP per distance with Spearman's ρ and OD50 per condition, the nights side by side, the
+input-size comparison, the acquisition policies, the illuminance sweep, ``day_paper`` and the
+night factors: those a folder holds (metric-300 has no native or policy sweeps). With
+``against``, another collection's folder: each condition's OD50s camera by camera in both, with
+SDs and ranks (metric-300 against quick).
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import numpy as np
@@ -27,40 +16,10 @@ import pandas as pd
 
 from benchmark.experiments.acceptance import ap_distance_rho
 from benchmark.experiments.sweep import od50_cell, with_censoring
+from benchmark.publish.sweep_tables import POLICY_CONDITIONS, REFERENCE_POLICY
 from benchmark.scoring.od50 import od50_rank_value
 
-REFERENCE_POLICY = "auto_peak (reference)"
-POLICIES = {"percentile:99": "-policy-percentile-99", "mean_level@0.18": "-policy-mean_level-0.18",
-            "hdr:16": "-policy-hdr-16"}  # the sweep folders' names after the collection's
-SWEEPS = {"": "", "-640": "-640", "-native": "-native", "-illuminance": "-lux", "-day-paper": "-day-paper"}
 NIGHTS = ("night", "night_regulation")  # the paper's night, then the unlit regulation road
-POLICY_CONDITIONS = ("dusk", "night")  # the acquisition policies: dusk and the paper's night
-
-
-def publish(results: Path, out: Path, collection: str = "quick") -> None:
-    """docs/data's CSVs from the sweep folders of ``collection`` under ``results``."""
-    out.mkdir(parents=True, exist_ok=True)
-    for suffix, folder_suffix in SWEEPS.items():
-        folder = collection + folder_suffix
-        if not (results / folder / "sweep.csv").is_file():  # absent, or a sweep still under way
-            print(f"no {results / folder}/sweep.csv: {out}/sweep{suffix}.csv and od50{suffix}.csv left as they are")
-            continue
-        for name in ("sweep", "od50"):
-            (out / f"{name}{suffix}.csv").write_bytes((results / folder / f"{name}.csv").read_bytes())
-    policies = {policy: collection + folder_suffix for policy, folder_suffix in POLICIES.items()}
-    if not all((results / folder / "sweep.csv").exists() for folder in policies.values()):
-        print(f"no policy sweeps under {results}: {out}/sweep-policies.csv and od50-policies.csv left as they are")
-        return
-    reference_cameras = set(pd.read_csv(results / next(iter(policies.values())) / "sweep.csv")["camera"])
-    for name in ("sweep", "od50"):
-        parts = []
-        reference = pd.read_csv(results / collection / f"{name}.csv")
-        reference = reference[reference["camera"].isin(reference_cameras)
-                              & reference["condition"].isin(POLICY_CONDITIONS)]
-        parts.append(reference.assign(exposure=REFERENCE_POLICY))
-        parts += [pd.read_csv(results / folder / f"{name}.csv").assign(exposure=policy)
-                  for policy, folder in policies.items()]
-        pd.concat(parts, ignore_index=True).to_csv(out / f"{name}-policies.csv", index=False)
 
 
 def _minus(text: str) -> str:
@@ -194,7 +153,7 @@ def three_nights_table(data: Path) -> str:
 
 
 def night_factors_table(data: Path) -> str:
-    """benchmarks/night_factors.py's rows: one change at a time at the paper's night's lux."""
+    """docs/data/night-factors.csv's rows (:mod:`benchmark.publish.night_factors`): one change at a time at the paper's night's lux."""
     rows = pd.read_csv(data / "night-factors.csv")
     ap_cols = [c for c in rows.columns if c.startswith("ap_")]
     lines = [_row(["camera", "factor", "change", "image-plane lux", "exposure (ms)", "car e⁻", "frame e⁻",
@@ -267,25 +226,3 @@ def tables(data: Path, against: Path | None = None, names: tuple[str, str] = ("q
 def markdown(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> str:
     """``tables`` as markdown, each under its ``###`` heading."""
     return "\n\n".join(f"### {heading}\n\n{text}" for heading, text in tables(data, against, names).items())
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("publish", help="copy the sweeps' tables into docs/data")
-    p.add_argument("--results", type=Path, default=Path("results"))
-    p.add_argument("--collection", default="quick", help="the sweep folders' names begin with it")
-    p.add_argument("--out", type=Path, default=Path("docs/data"))
-    m = sub.add_parser("markdown", help="print docs/results.md's tables")
-    m.add_argument("--data", type=Path, default=Path("docs/data"))
-    m.add_argument("--against", type=Path, help="another collection's tables (docs/data: quick's), camera by camera")
-    m.add_argument("--names", default="quick,metric-300", help="the --against collection's name, then --data's")
-    args = parser.parse_args()
-    if args.command == "publish":
-        publish(args.results, args.out, args.collection)
-    else:
-        print(markdown(args.data, args.against, tuple(args.names.split(","))))
-
-
-if __name__ == "__main__":
-    main()
