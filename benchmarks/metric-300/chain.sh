@@ -7,7 +7,7 @@
 # by scene; generate and verify leave a marker when done), so after a killed session run the same command again.
 # Long: about 11.5 h of generation and 4-5 h of sweep on 2 AVX2 cores (docs/performance.md).
 #
-#   nohup setsid bash benchmarks/metric300_chain.sh /work/m300 >> /work/m300-chain.log 2>&1 &
+#   nohup setsid bash benchmarks/metric-300/chain.sh /work/m300 >> /work/m300-chain.log 2>&1 &
 #
 # WORK (the first argument) holds the collection, the sweep folders and the markers, outside
 # git. Run it from a checkout nobody commits to while it runs (a `git worktree` of a landed
@@ -16,11 +16,11 @@
 # go under WORK. To try the chain on a small stand-in first: MANIFEST=<a shrunk copy of
 # metric-300.yaml> CAMERAS=cam12,cam01 DATA_OUT=<a folder outside git> (the submissions then
 # need WORK/leaderboard/protocols.yaml to accept the stand-in's manifest sha256).
-# Then benchmarks/metric300_land.sh, from the checkout that commits, brings tables, figures
+# Then benchmarks/metric-300/land.sh, from the checkout that commits, brings tables, figures
 # and submissions in and checks them.
 set -euo pipefail
-WORK=$(realpath -m "${1:?usage: metric300_chain.sh WORK}")
-cd "$(dirname "$0")/.."
+WORK=$(realpath -m "${1:?usage: chain.sh WORK}")
+cd "$(dirname "$0")/../.."
 export PYTHONPATH=$PWD  # this checkout's code, even where the venv's editable install points at another
 export METRICSCENES_MODEL_DIR=$(realpath "${METRICSCENES_MODEL_DIR:-../shared/models}")
 export MPLBACKEND=Agg PYTHONUNBUFFERED=1

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Bring what benchmarks/metric300_chain.sh made under WORK into this checkout, and check it:
+# Bring what benchmarks/metric-300/chain.sh made under WORK into this checkout, and check it:
 # the tables (docs/data/metric-300), the report's figures (docs/img/metric-300), the 13
 # reference submissions (leaderboard/submissions), every submission `--check`ed, the
 # leaderboard rendered twice and compared byte for byte, the findings tests on the tables,
@@ -7,15 +7,15 @@
 # docs/results.md). Refuses to start before the chain's tables are all there but day_paper's
 # (its sweep, the chain's last step, is brought in when present: run this again once it is).
 #
-#   bash benchmarks/metric300_land.sh /work /work/m300-code/docs/data/metric-300
+#   bash benchmarks/metric-300/land.sh /work /work/m300-code/docs/data/metric-300
 #
 # WORK: the chain's WORK; TABLES: the chain's DATA_OUT (in the checkout the chain ran from).
 # LEADERBOARD (default leaderboard), DATA (docs/data/metric-300) and IMG (docs/img/metric-300)
 # let it run on a stand-in (the findings tests then are not run).
 set -euo pipefail
-WORK=$(realpath "${1:?usage: metric300_land.sh WORK TABLES}")
-TABLES=$(realpath "${2:?usage: metric300_land.sh WORK TABLES}")
-cd "$(dirname "$0")/.."
+WORK=$(realpath "${1:?usage: land.sh WORK TABLES}")
+TABLES=$(realpath "${2:?usage: land.sh WORK TABLES}")
+cd "$(dirname "$0")/../.."
 export PYTHONPATH=$PWD MPLBACKEND=Agg
 LEADERBOARD=${LEADERBOARD:-leaderboard}
 DATA=${DATA:-docs/data/metric-300}
