@@ -65,8 +65,10 @@ variant=$(python3 -c "from metricscenes.render import resolve_variant; print(res
 stamp "installed; auto resolves to $variant"
 
 C=/tmp/m300-first$K
-sed "s/^environments: .*/environments: $K/; s/^name: \(.*\)/name: \1-first$K/" \
-  "${MANIFEST:-manifests/metric-300.yaml}" > /tmp/first.yaml
+# the text the CPU's copy of these K environments is made from (python -m metricscenes.first_environments): one sha256
+python3 -c 'import sys; from metricscenes.first_environments import first_manifest_text as first
+sys.stdout.write(first(open(sys.argv[1]).read(), int(sys.argv[2])))' "${MANIFEST:-manifests/metric-300.yaml}" "$K" \
+  > /tmp/first.yaml || exit 1
 nvidia-smi dmon -s um -d 5 > "$OUT/dmon.log" 2>&1 &
 dmon=$!
 # 8 render workers: session 13 found the GPU waiting for the CPU's scene building and encoding

@@ -1,13 +1,15 @@
 """The first K environments of a collection, finished or still rendering, as a collection of
-their own: its manifest with ``environments: K`` (and ``-firstK`` after its name, as
-benchmarks/gpu_scored_environments.sh writes it on a GPU machine), its finished units' arrays
-hard-linked (nothing is rendered or copied but metadata), then ``generate`` checks every unit
-against its record and writes the ground truth and resolved manifest.
+their own: its manifest with ``environments: K`` and ``-firstK`` after its name (the text a GPU
+machine renders the same K environments from: benchmarks/gpu_scored_environments.sh calls
+:func:`first_manifest_text`), its finished units' arrays hard-linked (nothing is rendered or
+copied but metadata), then ``generate`` checks every unit against its record and writes the
+ground truth and resolved manifest.
 
 So a collection another machine made of the same K environments can be scored beside this
-one's (``benchmark compare``; docs/performance.md, "On a GPU") before the whole is done.
+one's (``benchmark compare``, ``benchmark publish backend-scores``; docs/performance.md, "On a
+GPU") before the whole is done.
 
-    PYTHONPATH=. python benchmarks/first_environments.py /work/collections/metric-300 \
+    python -m metricscenes.first_environments /work/collections/metric-300 \
         manifests/metric-300.yaml 8 /work/collections/metric-300-first8
 """
 
@@ -28,8 +30,8 @@ from metricscenes.writer import VARIANT_STAMP
 
 
 def first_manifest_text(text: str, k: int) -> str:
-    """The manifest's YAML with ``environments: k`` and ``-firstk`` after its name (the sed
-    line of gpu_scored_environments.sh: the same text, so the same sha256)."""
+    """The manifest's YAML with ``environments: k`` and ``-firstk`` after its name, every other
+    line as it was (the GPU machine's manifest is this text: the same sha256)."""
     text = re.sub(r"(?m)^environments: .*$", f"environments: {k}", text)
     return re.sub(r"(?m)^name: (.*)$", rf"name: \1-first{k}", text)
 
