@@ -1,6 +1,6 @@
 """The first K environments of a collection, finished or still rendering, as a collection of
 their own: its manifest with ``environments: K`` and ``-firstK`` after its name (the text a GPU
-machine renders the same K environments from: benchmarks/gpu_scored_environments.sh calls
+machine renders the same K environments from: benchmarks/studies/gpu_scored_environments.sh calls
 :func:`first_manifest_text`), its finished units' arrays hard-linked (nothing is rendered or
 copied but metadata), then ``generate`` checks every unit against its record and writes the
 ground truth and resolved manifest.

@@ -1,12 +1,12 @@
 """Store codecs: bytes and write/read time of a collection's radiance arrays under lossless
 chains and BitRound, and BitRound's rounding error against the render's own Monte Carlo
-noise (issue 11.5; results in docs/performance.md, "Store size").
+noise (results in docs/performance.md, "Store size").
 
-    python benchmarks/store_codecs.py [--collection collections/quick] [--environments 0 7] [--slow]
-    python benchmarks/store_codecs.py --noise-units env000 env007 env007-d050m
-    python benchmarks/store_codecs.py --noise-units env000 --noise-manifest manifests/metric-300.yaml \
+    python benchmarks/studies/store_codecs.py [--collection collections/quick] [--environments 0 7] [--slow]
+    python benchmarks/studies/store_codecs.py --noise-units env000 env007 env007-d050m
+    python benchmarks/studies/store_codecs.py --noise-units env000 --noise-manifest manifests/metric-300.yaml \
         --noise-light-groups sky_day sky_night ego_lights
-    python benchmarks/store_codecs.py --whole --mantissa-bits 8 9
+    python benchmarks/studies/store_codecs.py --whole --mantissa-bits 8 9
 
 Codec study (default): every radiance array of the chosen environments (their plates, and
 the insets and car-lamp frames of their six scenes; every light group: day, dusk, night,

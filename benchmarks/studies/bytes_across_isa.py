@@ -1,6 +1,6 @@
 """Do a camera run's bytes depend on the instruction set the numeric libraries use?
 
-    PYTHONPATH=. python benchmarks/bytes_across_isa.py --collection collections/smoke [--camera cam12]
+    PYTHONPATH=. python benchmarks/studies/bytes_across_isa.py --collection collections/smoke [--camera cam12]
 
 Runs ``benchmark run`` (day) once per setting, each in a fresh process, and compares every
 camera image and ``detections.json`` by sha256 with the first setting's, and AP per distance:

@@ -11,8 +11,8 @@ side by side, per array: the ratio of mean luminances, and the RMS relative diff
 blocks at each size. Where the two differ only by render noise the RMS falls as 1/block
 (×4 from 4 to 16 px); a bias (a missing light, a wrong spectrum) does not fall.
 
-    python benchmarks/backend_agreement.py stats COLLECTION --units env000 env000-d025m ... --out a.npz
-    python benchmarks/backend_agreement.py compare a.npz b.npz
+    python benchmarks/studies/backend_agreement.py stats COLLECTION --units env000 env000-d025m ... --out a.npz
+    python benchmarks/studies/backend_agreement.py compare a.npz b.npz
 """
 
 from __future__ import annotations

@@ -2,11 +2,11 @@
 cam12 sees it, against cam12's own photon shot noise, in daylight, and the samples per
 pixel (spp) that put it under a third of the shot noise.
 
-    PYTHONPATH=. python benchmarks/render_noise.py --manifest manifests/quick.yaml --units env000 env000-d050m \\
+    PYTHONPATH=. python benchmarks/studies/render_noise.py --manifest manifests/quick.yaml --units env000 env000-d050m \\
         [--collection collections/quick]
-    PYTHONPATH=. python benchmarks/render_noise.py --manifest manifests/quick.yaml --units env000 env000-d050m \\
+    PYTHONPATH=. python benchmarks/studies/render_noise.py --manifest manifests/quick.yaml --units env000 env000-d050m \\
         --spp 16 64
-    PYTHONPATH=. python benchmarks/render_noise.py --manifest manifests/quick.yaml --units env000 \\
+    PYTHONPATH=. python benchmarks/studies/render_noise.py --manifest manifests/quick.yaml --units env000 \\
         --plate-width 960 --plate-height 540 [--spp 16 64] [--window 8] [--dark-e 1] [--work DIR]
 
 Method. Each unit (a plate ``envNNN``: the whole reference field; an inset
@@ -72,12 +72,12 @@ from pathlib import Path
 
 import numpy as np
 
-# This script's sibling in benchmarks/ (the script's folder is first on sys.path).
+# store_codecs: this script's sibling (the script's folder is first on sys.path).
 from store_codecs import Renders, noise_manifest, render_twice
 
-TARGET = 1.0 / 3.0  # render noise below a third of the shot noise
+from benchmark.measure.render_noise import capture_pair, channel_ratios, fitted_spp, pooled_ratio, spp_needed, used_pixels
+
 INSET_MARGIN_PX = 4  # sensor pixels left out along an inset window's edges (blend, lens blur)
-MIN_USED = 0.5  # a window counts when at least this fraction of its pixels is used
 
 
 def override_manifest(manifest, spp: int | None = None, width: int | None = None, height: int | None = None):
@@ -92,52 +92,6 @@ def override_manifest(manifest, spp: int | None = None, width: int | None = None
         grid = data["reference_grid"]
         data["reference_grid"] = grid | {"width_px": width or grid["width_px"], "height_px": height or grid["height_px"]}
     return parse_manifest(data, "overridden manifest")
-
-
-def pooled_ratio(e_a: np.ndarray, e_b: np.ndarray, used: np.ndarray, window: int) -> dict:
-    """Render noise over shot noise of two noise-free captures ``e_a``, ``e_b`` (electrons)
-    of two renders that differ only in seed, over the ``used`` pixels:
-
-    overall: sqrt(sum (e_a - e_b)^2 / 2 / sum (e_a + e_b) / 2);
-    windows: the same per ``window`` x ``window`` block (the region cut to whole blocks),
-    over the blocks with at least ``MIN_USED`` of their pixels used: median, 90th
-    percentile, fraction above :data:`TARGET`; used: the fraction of pixels used.
-    """
-    a, b = np.asarray(e_a, np.float64), np.asarray(e_b, np.float64)
-    u = np.asarray(used, bool) & np.isfinite(a) & np.isfinite(b)
-    noise = np.where(u, (a - b) ** 2 / 2, 0.0)
-    shot = np.where(u, (a + b) / 2, 0.0)
-    total = float(shot.sum())
-    out = {"used": float(u.mean()) if u.size else 0.0,
-           "overall": float(np.sqrt(noise.sum() / total)) if total > 0 else float("nan")}
-    rows, cols = (n // window * window for n in u.shape)
-
-    def blocks(x):
-        return x[:rows, :cols].reshape(rows // window, window, cols // window, window).sum(axis=(1, 3))
-
-    count, noise_w, shot_w = blocks(u.astype(np.float64)), blocks(noise), blocks(shot)
-    keep = (count >= MIN_USED * window * window) & (shot_w > 0)
-    ratios = np.sqrt(noise_w[keep] / shot_w[keep])
-    out["windows"] = int(ratios.size)
-    if ratios.size:
-        out |= {"median": float(np.median(ratios)), "p90": float(np.percentile(ratios, 90)),
-                "above": float(np.mean(ratios > TARGET))}
-    else:
-        out |= {"median": float("nan"), "p90": float("nan"), "above": float("nan")}
-    return out
-
-
-def spp_needed(spp: int, ratio: float) -> float:
-    """The spp at which a ratio measured at ``spp`` falls to :data:`TARGET` (noise ~ 1/sqrt(spp))."""
-    return spp * (ratio / TARGET) ** 2
-
-
-def used_pixels(e_a: np.ndarray, e_b: np.ndarray, saturation_e: float, dark_e: float) -> tuple[np.ndarray, dict]:
-    """Pixels below saturation in both captures and at least ``dark_e`` on average; and
-    the fractions left out for each reason."""
-    saturated = np.maximum(e_a, e_b) >= saturation_e
-    dark = (e_a.astype(np.float64) + e_b) / 2 < dark_e
-    return ~saturated & ~dark, {"saturated": float(saturated.mean()), "dark": float((dark & ~saturated).mean())}
 
 
 def inset_box(inset_extent, camera, field) -> tuple[slice, slice] | None:
@@ -187,30 +141,6 @@ def scenes(layers: dict[str, dict[str, Renders]], unit: str, inset_feather: floa
     return out
 
 
-def capture_pair(scene_a, scene_b, camera):
-    """Noise-free captures of both renders: A with the camera's exposure policy, B with
-    A's exposure time. Returns (e_A, e_B, exposure s, B's own auto exposure s)."""
-    from benchmark.camera import ExposureSpec
-    from benchmark.camera.exposure import exposure_time_s, with_exposure
-    from benchmark.camera.pipeline import simulate
-
-    if camera.exposure.mode == "hdr":
-        raise SystemExit(f"{camera.name}: the hdr policy takes two exposures; choose a one-frame policy")
-    cap_a = simulate(scene_a, camera, seed=0, noise=False)
-    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=cap_a.exposure_s))
-    cap_b = simulate(scene_b, fixed, seed=0, noise=False)
-    own_b = exposure_time_s(cap_b.electrons / np.float32(cap_a.exposure_s), camera.sensor, camera.exposure)
-    return cap_a.electrons, cap_b.electrons, cap_a.exposure_s, own_b
-
-
-def channel_ratios(e_a, e_b, used, cfa: str) -> str:
-    """Overall ratio per colour channel of the mosaic, 'R / G / B'."""
-    from benchmark.camera.sensor import cfa_index
-
-    channel = cfa_index(*e_a.shape, cfa)
-    return " / ".join(f"{pooled_ratio(e_a, e_b, used & (channel == c), 1)['overall']:.3f}" for c in range(3))
-
-
 def collection_check(collection, manifest, layers: dict[str, dict[str, Renders]]) -> str:
     """Whether render A of every array, written as the collection's ``store`` writes it
     (rounded, through the basis; ``manifest``, the one rendered here, has no store), is the
@@ -230,16 +160,6 @@ def collection_check(collection, manifest, layers: dict[str, dict[str, Renders]]
     same = all(array_sha256(read_back(*stored_form(r.a, mantissa_bits, basis_k))) == recorded[p]
                for renders in layers.values() for p, r in renders.items())
     return "yes" if same else "NO"
-
-
-def fitted_spp(points: list[tuple[int, float]]) -> tuple[float, float]:
-    """From ratios measured at two or more spp, ``(spp, ratio)``: the exponent alpha of
-    ratio ~ spp^-alpha (least squares in log-log) and the spp at which the fitted line
-    reaches :data:`TARGET` (nan where the ratio does not fall with spp)."""
-    x, y = np.log([p[0] for p in points]), np.log([p[1] for p in points])
-    slope, intercept = np.polyfit(x, y, 1)
-    alpha = -float(slope)
-    return alpha, float(np.exp((intercept - np.log(TARGET)) / alpha)) if alpha > 0 else float("nan")
 
 
 def measure(manifest, units: list[str], camera, work: Path, window: int, dark_e: float | None,

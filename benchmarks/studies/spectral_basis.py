@@ -1,9 +1,9 @@
 """A spectral basis per radiance array (ISETCam's hypercube basis, ``hcBasis``): how much
 of the signal K basis spectra keep, against the render's own noise.
 
-    PYTHONPATH=. python benchmarks/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
+    PYTHONPATH=. python benchmarks/studies/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
         [--light-groups sky_day] [--ranks 3 4 6 8 10]
-    PYTHONPATH=. python benchmarks/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
+    PYTHONPATH=. python benchmarks/studies/spectral_basis.py --manifest manifests/quick.yaml --units env000-d050m \\
         --ranks 6 8 10 --held day night [--hold imx363+y|xyz|none]
 
 ``--held``: the store's basis (``store.spectral_basis``: the sensor's channels and Y held,
@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-# A sibling in benchmarks/ (the script's folder is first on sys.path).
+# store_codecs: this script's sibling (the script's folder is first on sys.path).
 from store_codecs import noise_manifest, render_twice
 
 HELD_CAMERAS = ["cam12", "cam01", "cam08"]  # the reference; the largest pixels; the slowest lens (most blur per band)
@@ -143,12 +143,12 @@ def judged_scenes(arrays: dict, weights: dict[str, float], feather: float):
 def camera_judge(manifest, units: list[str], ranks: list[int], conditions: list[str], work: Path, hold: str) -> None:
     """Per unit, condition, rank and camera: the render noise (A against B) and what the
     held basis loses (A against A stored through it), both over the shot noise of
-    noise-free captures (``render_noise.pooled_ratio``), and the bytes it stores."""
+    noise-free captures (:func:`benchmark.measure.render_noise.pooled_ratio`), and the bytes it stores."""
     from benchmark.camera import load_camera
     from benchmark.camera.sensor import saturation_electrons
+    from benchmark.measure.render_noise import capture_pair, pooled_ratio, used_pixels
     from metricscenes.spectral import WAVELENGTHS_NM
     from metricscenes.spectral_basis import basis_for
-    from render_noise import capture_pair, pooled_ratio, used_pixels
 
     held = held_spectra(np.asarray(WAVELENGTHS_NM, float), hold)
     bits = manifest.store.mantissa_bits if manifest.store else None

@@ -3,11 +3,11 @@
 # twice: with an empty Dr.Jit kernel cache (cold) and again into a new folder (warm), so the
 # difference is the kernel compilation. Brings back, under $OUT, the logs, the units'
 # seconds (progress/*.json) and each environment's block luminances for
-#   python benchmarks/backend_agreement.py compare gpu-env000.npz cpu-env000.npz
+#   python benchmarks/studies/backend_agreement.py compare gpu-env000.npz cpu-env000.npz
 # against the same units rendered with llvm_ad_spectral on a CPU (docs/performance.md, "On a GPU").
 #
 # Prepare here: bash ../shared/tools/gpu-wheels.sh   (writes .whl/, which the device run carries)
-# Run there:    bash benchmarks/gpu_first_environments.sh K SECONDS   (K environments, SECONDS in all)
+# Run there:    bash benchmarks/studies/gpu_first_environments.sh K SECONDS   (K environments, SECONDS in all)
 set -uo pipefail
 K=${1:-2}
 TOTAL=${2:-540}
@@ -37,7 +37,7 @@ run() {  # folder, seconds at most
 run cold $(( $(left) - 150 ))
 for env in $(seq -f 'env%03g' 0 $(( K - 1 ))); do
   units=$(cd /tmp/cold/progress 2>/dev/null && ls | grep -E "^$env(-d[0-9]+m)?\.json$" | sed 's/\.json$//')
-  [ -n "$units" ] && python3 benchmarks/backend_agreement.py stats /tmp/cold --units $units --out "$OUT/gpu-$env.npz"
+  [ -n "$units" ] && python3 benchmarks/studies/backend_agreement.py stats /tmp/cold --units $units --out "$OUT/gpu-$env.npz"
 done
 { s=$(date +%s); timeout 60 python3 -m metricscenes.cli verify /tmp/cold; echo "verify: exit $?, $(( $(date +%s) - s )) s"; } \
   >> "$OUT/info.txt" 2>&1

@@ -1,7 +1,7 @@
 """The car lamps' whole frame on a coarser grid (``render.frame_divisor``): what it saves
 and what the reference camera sees of it, at night.
 
-    PYTHONPATH=. python benchmarks/frame_sampling.py --collection /tmp/m300-2 \\
+    PYTHONPATH=. python benchmarks/studies/frame_sampling.py --collection /tmp/m300-2 \\
         --units env001-d050m env001-d150m --divisors 2 4 [--camera cam12] [--condition night]
 
 Every inset unit also renders ``frames/<scene>/car_lights``: the car's lamps over the whole
@@ -32,8 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-# Siblings in benchmarks/ (the script's folder is first on sys.path).
-from render_noise import capture_pair, pooled_ratio, used_pixels
+from benchmark.measure.render_noise import capture_pair, pooled_ratio, used_pixels
 
 
 def frame_renders(collection, unit_key: str, divisors: list[int], work: Path) -> dict:

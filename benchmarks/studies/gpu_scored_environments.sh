@@ -4,12 +4,12 @@
 # compared by score with the CPU's (docs/performance.md, "On a GPU"): only the small outputs
 # come back (the runs' detections and results, the sweep's tables, the units' seconds).
 #
-# Here, once:   bash benchmarks/gpu_scored_environments.sh prepare
+# Here, once:   bash benchmarks/studies/gpu_scored_environments.sh prepare
 #   (../shared/tools/gpu-wheels.sh's .whl/, with colour-science's coverage report and
 #   colour-demosaicing's notebook left out so that the detector fits in the 64 MiB that
 #   travels; the sweep's two wheels; the default detector in .gpu-models/)
-# There:        bash benchmarks/gpu_scored_environments.sh K SECONDS CAMERAS CONDITIONS
-#   e.g.        bash benchmarks/gpu_scored_environments.sh 10 540 all day,night
+# There:        bash benchmarks/studies/gpu_scored_environments.sh K SECONDS CAMERAS CONDITIONS
+#   e.g.        bash benchmarks/studies/gpu_scored_environments.sh 10 540 all day,night
 # Then here:    benchmark publish backend-scores ...  (compares with the CPU's runs)
 set -uo pipefail
 
@@ -71,7 +71,7 @@ sys.stdout.write(first(open(sys.argv[1]).read(), int(sys.argv[2])))' "${MANIFEST
   > /tmp/first.yaml || exit 1
 nvidia-smi dmon -s um -d 5 > "$OUT/dmon.log" 2>&1 &
 dmon=$!
-# 8 render workers: session 13 found the GPU waiting for the CPU's scene building and encoding
+# 8 render workers: with fewer the GPU waited for the CPU's scene building and encoding
 timeout $(( $(left) - 240 )) python3 -m metricscenes.cli generate --manifest /tmp/first.yaml --out $C --workers 8 \
   > "$OUT/generate.log" 2>&1
 stamp "generate: exit $?, store $(du -sh $C/radiance.zarr | cut -f1)"
