@@ -112,6 +112,25 @@ def backend_scores(
     print("\n".join([HEADER, *lines]))
 
 
+@app.command("mtf50-isp")
+def mtf50_isp(
+    cameras: Annotated[str, typer.Option(help="comma list of registry cameras with a published MTF50 group")] = "all",
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help=CSV_OUT)] = None,
+) -> None:
+    """MTF50 on ISETCam's terms: its curve, and our e-SFR with the project's ISP, ISETCam's ISP, and both of ISETCam's."""
+    from benchmark.camera import list_cameras, load_camera
+    from benchmark.publish.mtf50_isp import markdown, mtf50_isp_table
+    from metricscenes.cli_support import fail
+
+    try:
+        table = mtf50_isp_table(list_cameras() if cameras == "all" else [load_camera(n) for n in _names(cameras)])
+    except ValueError as exc:
+        fail(str(exc).splitlines()[0])
+    if out:
+        table.to_csv(out, index=False)
+    print(markdown(table))
+
+
 @app.command("night-exposure")
 def night_exposure(
     collection: Annotated[Path, typer.Option(help="collection folder")],
