@@ -88,7 +88,9 @@ WINGS = {
                     "a run chains camera, detector and scoring over a collection and writes result files"),
     "leaderboard": (("camera", "detectors", "scoring", "result_files"),
                     "it judges a submission from its records, spec and detector, and runs no experiment"),
-    "cli": (("camera", "detectors", "measure", "scoring", "result_files", "experiments", "leaderboard"),
+    "publish": (("camera", "detectors", "measure", "scoring", "result_files", "experiments"),
+                "what the docs publish (tables, the results page, studies' CSVs) is made from runs and sweeps"),
+    "cli": (("camera", "detectors", "measure", "scoring", "result_files", "experiments", "leaderboard", "publish"),
             "the commands sit on top: they call every wing and nothing imports them"),
 }
 

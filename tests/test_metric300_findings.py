@@ -1,7 +1,7 @@
 """The paper's findings on metric-300 (50 environments x 6 distances), checked on the published
-tables in docs/data/metric-300 (written by benchmarks/metric300_chain.sh; the commands are in
-docs/results.md, "Regenerate metric-300"). The thresholds were written before the tables existed; until they are published
-every test here is skipped with that reason."""
+tables in docs/data/metric-300 (written by the metric-300 chain's `benchmark publish` steps; the
+commands are in docs/results.md, "Regenerate metric-300"). The thresholds were written
+before the tables existed; until they are published every test here is skipped with that reason."""
 
 from pathlib import Path
 
@@ -15,7 +15,7 @@ DATA = DOCS_DATA / "metric-300"
 CONDITIONS = {"day", "dusk", "night", "night_regulation"}
 
 pytestmark = pytest.mark.skipif(not (DATA / "sweep.csv").is_file(),
-                                reason="docs/data/metric-300 is not published yet (benchmarks/metric300_chain.sh)")
+                                reason="docs/data/metric-300 is not published yet (benchmarks/metric-300/chain.sh)")
 
 
 def _load(suffix: str) -> tuple[pd.DataFrame, pd.DataFrame]:
