@@ -8,7 +8,7 @@ record (bad JSON, a missing column, a field of the wrong type):
 | file | model | read / write | written by | read by |
 |---|---|---|---|---|
 | ``results.json`` | :class:`RunResults` | :func:`read_results` / :func:`write_results` | ``experiments.run`` | sweep (cache), report, compare, ``leaderboard.submission``, cli |
-| ``od50.json`` | :class:`Od50Cache` (:class:`Od50Bootstrap`) | :func:`read_od50_cache` / :func:`write_od50_cache` | ``experiments.sweep.run_od50`` | sweep, report, submission |
+| ``od50.json`` | :class:`Od50Cache` (:class:`~benchmark.scoring.bootstrap.Od50Bootstrap`) | :func:`read_od50_cache` / :func:`write_od50_cache` | ``experiments.sweep.run_od50`` | sweep, report, submission |
 | ``sweep.csv`` | :class:`SweepRow`, one per row | :func:`read_sweep_table` / :func:`write_sweep_table` | sweep | report, spm, acceptance, cli |
 | ``od50.csv`` | :class:`Od50Row`, one per row | :func:`read_od50_table` / :func:`write_od50_table` | sweep | report, spm, acceptance, cli |
 | ``sweep.json`` | :class:`SweepRecord` | :func:`read_sweep_record` / :func:`write_sweep_record` | sweep | report, compare |
@@ -41,35 +41,23 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, BeforeValidator, ConfigDict, ValidationError
+from pydantic import ValidationError
 
+from benchmark.record_base import Censored, JsonFloat, Record
+from benchmark.scoring.bootstrap import Od50Bootstrap
+from benchmark.scoring.od50 import od50_censoring
 from metricscenes.files import write_atomic
 
 RESULTS_FORMAT = "metricscenes-results/1"
 SWEEP_FORMAT = "metricscenes-sweep/1"
 DEFAULT_SCORING_BACKEND = "faster-coco-eval"
-Censored = Literal["", ">", "<"]  # "" measured, ">" a lower bound (farthest distance), "<" an upper bound (nearest)
 
 
 class ResultsFileError(ValueError):
     """A result file that is not its record: one line naming the file and what is wrong."""
-
-
-def _nan_if_none(value):
-    return float("nan") if value is None else value
-
-
-# A float that strict JSON writes as null (NaN) or "inf"/"-inf" (json_safe); read back as the float.
-JsonFloat = Annotated[float, BeforeValidator(_nan_if_none)]
-
-
-class Record(BaseModel):
-    """Base of every record: unknown keys are kept, in the order read, after the known ones."""
-
-    model_config = ConfigDict(extra="allow")
 
 
 # ── results.json: one camera × one condition (benchmark.experiments.run) ───────────────────
@@ -165,7 +153,7 @@ class RunResults(Record):
     subset: Subset | None = None
     exposure_short_s: dict[str, float] | None = None  # hdr only: the short frames per scene id
     captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
-    composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before session 12
+    composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before v0.1.0a5
     condition_weights: dict[str, dict] | None = None  # a targeted condition: per scene, target and weights (metricscenes.targets)
     numerics: dict | None = None  # versions, ISA class and kernels that decided the bytes (metricscenes.numeric_pins)
 
@@ -175,8 +163,6 @@ class RunResults(Record):
 
     def od50_censoring(self) -> tuple[str, float | None]:
         """(censored, bound_m) of this run's AP curve (:func:`benchmark.scoring.od50.od50_censoring`)."""
-        from benchmark.scoring.od50 import od50_censoring
-
         return od50_censoring(*self.ap_curve())
 
 
@@ -229,23 +215,6 @@ class RunFolder:
     @property
     def condition(self) -> str:
         return self.results.condition
-
-
-class Od50Bootstrap(Record):
-    """OD50 with its bootstrap spread over environments (:func:`benchmark.scoring.bootstrap_od50`).
-
-    Caches written before censoring was recorded lack ``censored`` and ``bound_m``; hand-made
-    ones may lack the counts.
-    """
-
-    od50_m: JsonFloat  # of the full set, m; +inf where AP never falls to 0.5; extrapolated where censored
-    sd_m: JsonFloat  # SD (ddof 1) of the finite resampled OD50s, m; NaN with fewer than two
-    ci95_m: tuple[JsonFloat, JsonFloat]  # percentile interval (95 % by default), m; an end may be +inf
-    n_resamples: int
-    n_environments: int | None = None  # the environments resampled (each keeps all its distances)
-    n_infinite: int | None = None  # resamples whose OD50 is +inf (they still enter the interval)
-    censored: Censored | None = None  # of the full set (benchmark.scoring.od50.od50_censoring)
-    bound_m: float | None = None  # the farthest (">") or nearest ("<") measured distance; None when not censored
 
 
 class Od50CacheKey(Record):

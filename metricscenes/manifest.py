@@ -142,8 +142,9 @@ class RenderSettings(_Strict):
         "rendered sky that has one above the horizon (the plate has no car, so a shadow outside the window is "
         "lost; unset: the car's box and margins only); see metricscenes.generate.inset_window and docs/scenes.md, "
         "'The car's shadow'")
-    # "auto": cuda_ad_spectral where a CUDA device is usable, else scalar_spectral (the variant used is
-    # recorded in manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
+    # "auto": cuda_ad_spectral where a CUDA device is usable, else llvm_ad_spectral where a libLLVM >= 17
+    # renders, else scalar_spectral (metricscenes.render.resolve_variant; the variant used is recorded in
+    # manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
     variant: Literal["scalar_spectral", "llvm_ad_spectral", "cuda_ad_spectral", "auto"] = "scalar_spectral"
 
     @field_validator("plate_spp", "inset_spp")

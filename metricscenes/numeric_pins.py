@@ -45,6 +45,23 @@ def cpu_flags() -> frozenset[str]:
     return frozenset()
 
 
+def cpu_vendor() -> str:
+    """The CPU's vendor as Linux reports it ('GenuineIntel', 'AuthenticAMD'; '' where unknown).
+
+    With the ISA class it names the kind of machine whose ray-tracer bytes agree: Embree's
+    approximate reciprocals (``rcpps``, ``vrcp14ps``) are specified only to a relative error,
+    so two vendors' CPUs may round them differently, and smoke's radiance does differ between
+    an Intel and an AMD AVX-512 machine (tests/golden)."""
+    try:
+        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
+            for line in f:
+                if line.startswith("vendor_id"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return ""
+
+
 def isa_class(flags: frozenset[str] | None = None) -> str:
     """'avx512', 'avx2' or 'other': the kernel class Embree and onnxruntime take here."""
     flags = cpu_flags() if flags is None else flags

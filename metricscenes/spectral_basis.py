@@ -14,7 +14,7 @@ array's 8 x 8-pixel means, each spectrum scaled to unit length, once the held sp
 out: the spectral shapes the scene has beyond what the channels see, which the lens's blur
 per band can still tell apart.
 
-Measured (benchmarks/spectral_basis.py ``--held``; docs/performance.md, "A spectral basis per
+Measured (benchmarks/studies/spectral_basis.py ``--held``; docs/performance.md, "A spectral basis per
 array"): with K = 8, noise-free captures of a scene stored through the basis differ from the
 render's by 1-8 % of the render's own noise for cam12, cam01 and cam08, day and night, and
 the array takes about 0.3 of the bytes. A sensor with other channels is not held: with

@@ -61,7 +61,7 @@ WRITE_CONFIG = {"write_empty_chunks": True}
 # shrinks; the shuffle puts the sign-exponent bytes of all values together, where they
 # compress well. Against zarr's default (bytes + zstd level 0, what collections were written
 # with before: they still read) 6 % smaller, written 3x faster, read as fast (measured by
-# benchmarks/store_codecs.py: docs/performance.md, "Store size").
+# benchmarks/studies/store_codecs.py: docs/performance.md, "Store size").
 RADIANCE_COMPRESSORS = ({"name": "blosc", "configuration": {"cname": "zstd", "clevel": 1, "shuffle": "shuffle",
                                                              "typesize": 4, "blocksize": 2**30}},)
 # c-blosc 1 refuses buffers of 2 GiB or more: such a chunk (a film the manifest's bounds allow

@@ -44,23 +44,3 @@ def smoke_collection(tmp_path_factory, smoke_manifest) -> Path:
     generate(smoke_manifest, out)
     return out
 
-
-@pytest.fixture(scope="session")
-def load_benchmark():
-    """``load_benchmark("render_noise")``: a script of benchmarks/ as a module, loaded as
-    running it would (its folder first on sys.path, so its siblings import)."""
-    import importlib.util
-
-    loaded = {}
-
-    def load(name: str):
-        if name not in loaded:
-            with pytest.MonkeyPatch.context() as mp:
-                mp.syspath_prepend(str(REPO / "benchmarks"))
-                spec = importlib.util.spec_from_file_location(name, REPO / "benchmarks" / f"{name}.py")
-                module = importlib.util.module_from_spec(spec)
-                spec.loader.exec_module(module)
-            loaded[name] = module
-        return loaded[name]
-
-    return load

@@ -25,9 +25,9 @@ def write_synthetic_run(
     distances_m=None,
 ) -> dict:
     """Write a run folder for ``camera`` (a CameraSpec) on ``manifest`` (a Manifest); returns results."""
-    from benchmark.experiments.run import RESULTS_FORMAT, AP_SCORE_THRESHOLD, _finite_or_none
+    from benchmark.experiments.run import RESULTS_FORMAT, _finite_or_none
     from benchmark.detectors import registry
-    from benchmark.scoring import ap_by_distance, od50
+    from benchmark.scoring import AP_SCORE_THRESHOLD, ap_by_distance, od50
     from synthetic_scoring import synthetic_collection
     from metricscenes import __version__
 

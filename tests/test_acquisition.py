@@ -1,4 +1,4 @@
-"""Acquisition as a value (issue 27): one function per strategy returning a RawCapture — one
+"""Acquisition as a value: one function per strategy returning a RawCapture — one
 exposure, two-frame HDR, an HDR pixel (dual conversion gain + split pixel) merged on the
 sensor and companded; RCCB / RCCC colour filters and their ISP; the automotive cameras and
 their datasheet figures (photon transfer); lens tables hashed by content; the paper's

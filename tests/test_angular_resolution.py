@@ -1,8 +1,8 @@
-"""Angular resolution beside sensor-plane MTF50 (issue 26, point 3): cycles/mrad in object space
+"""Angular resolution beside sensor-plane MTF50: cycles/mrad in object space
 (MTF50 × focal length / 1000) with focal length and field of view in `cameras list/show/mtf`,
 results.json, sweep tables, the report and the leaderboard; the SPM and OD50-vs-MTF50 figures use
 the angular axis when the compared cameras' focal lengths differ, and say which axis they use.
-Also the OD50 axis that censored points cannot stretch (issue 26, point 7)."""
+Also the OD50 axis that censored points cannot stretch."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Backends and the render variant (issue 11, points 3-4): `generate` and `benchmark sweep`
+"""Backends and the render variant: `generate` and `benchmark sweep`
 write the same bytes in this process, on a process pool and on a dask LocalCluster;
 ``render.variant: auto`` is resolved, recorded and kept on resume; a ``--scheduler`` that
 cannot be used is one line before anything is written."""

@@ -1,4 +1,4 @@
-"""Bad inputs to `metricscenes generate` and `benchmark run` (issue 13, points 6-8):
+"""Bad inputs to `metricscenes generate` and `benchmark run`:
 each ends in a non-zero exit and one line, never a traceback, and nothing is created or
 lost (no `--out`, existing files byte-identical). Also the writer's lock per collection
 and a detector whose outputs are NaN."""

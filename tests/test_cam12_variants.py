@@ -1,4 +1,4 @@
-"""The two variants of cam12 for the lens comparison (issue 27; docs/camera.md, "Two variants of
+"""The two variants of cam12 for the lens comparison (docs/camera.md, "Two variants of
 cam12 for the lens comparison"): cameras/cam12-aberrated.yaml (a quarter-wave defocus and
 spherical aberration at cam12's f/1.9) and cameras/cam12-flare.yaml (veiling glare on). Each is
 cam12 but for its lens; the aberrated lens resolves less, and the glare moves light without

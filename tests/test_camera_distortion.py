@@ -1,4 +1,4 @@
-"""Radial lens distortion (issue 14.1, Brown–Conrady k1, k2): the inverse is exact, a
+"""Radial lens distortion (Brown–Conrady k1, k2): the inverse is exact, a
 point target lands where the model puts it, ground truth follows the lens, a lens that
 folds is refused, and a zero distortion changes nothing (specs, hashes, images)."""
 

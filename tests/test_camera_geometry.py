@@ -1,4 +1,4 @@
-"""A camera's own field of view (issue 14.1): focal length and pixel array set the field,
+"""A camera's own field of view: focal length and pixel array set the field,
 the camera samples its window of the collection's field, ground truth follows the same
 mapping, a camera wider than the collection is refused, and the 13 registry cameras are
 unchanged. Synthetic scenes of one band (550 nm), no renders."""

@@ -64,7 +64,7 @@ def test_bad_yaml_gives_one_line_value_error(tmp_path, text, pattern):
     assert "\n" not in str(info.value)
 
 
-# --- specs validated as a whole (issue 13.7) ----------------------------------------------
+# --- specs validated as a whole ----------------------------------------------------------
 
 _BASE = "name: x\noptics: {f_number: 2}\n"
 

@@ -1,4 +1,4 @@
-"""The smaller items of issue 26, point 7: `--model-dir` on every command that loads a model,
+"""Command-line conveniences: `--model-dir` on every command that loads a model,
 "did you mean" for conditions (never taken silently), help that uses the terminal's width, and
 `benchmark report` over several run and sweep folders. Each refusal: exit code 2, one line,
 nothing created."""

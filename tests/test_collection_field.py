@@ -1,4 +1,4 @@
-"""A collection's own field of view (issue 14.1): a manifest may set
+"""A collection's own field of view: a manifest may set
 ``reference_grid.hfov_deg``; the renders, the stored extents, the ground truth and the
 cameras all follow it, and every earlier manifest keeps its sha256. One tiny render."""
 

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from benchmark.detectors import COCO80_NAMES, Detection, coco80_class_id, coco_category_id
+from benchmark.coco import COCO80_NAMES, coco80_class_id, coco_category_id
+from benchmark.detectors import Detection
 from benchmark.detectors.letterbox import letterbox, pad_to_stride, resize_linear
 from benchmark.detectors.nms import batched_nms, nms
 from benchmark.detectors.policy import parse_input_size, plan_passes

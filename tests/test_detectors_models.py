@@ -6,8 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from benchmark.coco import box_iou
 from benchmark.detectors import load_detector
-from benchmark.detectors.nms import batched_nms, box_iou
+from benchmark.detectors.nms import batched_nms
 from benchmark.detectors.onnx_detector import infer_family, open_session
 
 REPO = Path(__file__).resolve().parents[1]

@@ -1,35 +1,34 @@
-"""benchmarks/first_environments.py: a collection's first K environments as a collection of
+"""metricscenes.first_environments: a collection's first K environments as a collection of
 their own, for scoring beside the same K rendered elsewhere (docs/performance.md, "On a GPU")."""
 
 import json
 import shutil
-import subprocess
 
 import pytest
 
 from conftest import REPO, SMOKE_MANIFEST
+from metricscenes import first_environments
 
 
-@pytest.fixture(scope="module")
-def first_environments(load_benchmark):
-    return load_benchmark("first_environments")
+def test_manifest_text_changes_the_count_and_the_name_only():
+    """The GPU machine renders from this text too, so both machines' collections carry one
+    manifest sha256 and `benchmark compare` pairs their runs."""
+    import yaml
 
+    from metricscenes.manifest import load_manifest, parse_manifest
 
-def test_manifest_text_is_the_gpu_scripts(first_environments, tmp_path):
-    """The same text as the sed line of gpu_scored_environments.sh, so both machines' collections
-    carry one manifest sha256 and `benchmark compare` pairs their runs."""
-    script = (REPO / "benchmarks" / "gpu_scored_environments.sh").read_text()
-    sed = next(line for line in script.splitlines() if line.startswith("sed "))
-    expression = sed.split('"')[1].replace("$K", "8")
     source = (REPO / "manifests" / "metric-300.yaml").read_text()
-    by_sed = subprocess.run(["sed", expression], input=source, capture_output=True, text=True, check=True).stdout
     text = first_environments.first_manifest_text(source, 8)
-    assert text == by_sed
-    assert "\nenvironments: 8\n" in text and "\nname: metric-300-first8\n" in text
+    changed = [(a, b) for a, b in zip(source.splitlines(), text.splitlines()) if a != b]
+    assert changed == [("name: metric-300", "name: metric-300-first8"), ("environments: 50", "environments: 8")]
+    assert len(text.splitlines()) == len(source.splitlines())
+    first = parse_manifest(yaml.safe_load(text), source="first 8")
+    whole = load_manifest(REPO / "manifests" / "metric-300.yaml")
+    assert first.environments == 8 and first.seed == whole.seed and first.render == whole.render
 
 
 @pytest.mark.slow
-def test_first_environment_of_smoke(first_environments, smoke_collection, tmp_path):
+def test_first_environment_of_smoke(smoke_collection, tmp_path):
     from metricscenes.store import Collection, verify_collection
 
     root_meta = (smoke_collection / "radiance.zarr" / "zarr.json").read_bytes()
@@ -47,7 +46,7 @@ def test_first_environment_of_smoke(first_environments, smoke_collection, tmp_pa
     assert chunk.stat().st_nlink >= 2
 
 
-def test_refuses_an_unfinished_source_and_an_existing_folder(first_environments, smoke_collection, tmp_path, capsys):
+def test_refuses_an_unfinished_source_and_an_existing_folder(smoke_collection, tmp_path, capsys):
     partial = tmp_path / "partial"
     shutil.copytree(smoke_collection / "progress", partial / "progress")
     (partial / "progress" / "env000-d200m.json").unlink()

@@ -147,21 +147,19 @@ def test_collection_gives_the_inset_its_car_map_unless_asked_for_the_whole_windo
         c.radiance("env000-d100m", "day", inset_resolution="sharp")
 
 
-def test_seam_check_sees_the_window_and_not_the_fix(smoke_collection, load_benchmark):
-    from benchmark.camera.registry import camera_from_dict
-    from metricscenes.store import Collection
-
-    cf = load_benchmark("composite_fidelity")
+def test_seam_check_sees_the_window_and_not_the_fix(smoke_collection):
     import yaml
 
-    from benchmark.camera.registry import DATA_DIR
+    from benchmark.camera.registry import DATA_DIR, camera_from_dict
+    from benchmark.measure.seam import seam_check
+    from metricscenes.store import Collection
 
     small = yaml.safe_load((DATA_DIR / "cam12.yaml").read_text())  # cam12 with 4x its pixel: 480 x 270,
     small["sensor"].update(pixel_um=5.6)                           # 2.4x finer than smoke's plate
     small.update(name="cam12-5.6um", mtf50_group_cy_per_mm=None)
     camera = camera_from_dict(small)
     c = Collection.open(smoke_collection)
-    before, after = (cf.seam_check(c, "env000-d025m", "day", camera, mode) for mode in ("window", "car"))
+    before, after = (seam_check(c, "env000-d025m", "day", camera, mode) for mode in ("window", "car"))
     assert before["outside_de"] < 0.05 and after["outside_de"] < 0.05
     # (smoke's 4-spp plate is noisy: what is left after the fix is its render noise against the inset's)
     assert before["window_de_p99"] > 2 * after["window_de_p99"]

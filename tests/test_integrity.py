@@ -281,7 +281,7 @@ def test_a_plate_is_mixed_once_for_its_scenes_and_read_again_once_changed(smoke_
         c.radiance("env001-d050m", "day")  # its file changed: read again, and checked
 
 
-# --- array attributes under the checksum (issue 24, point 2) ------------------------------
+# --- array attributes under the checksum ------------------------------------------------
 
 def _set_attribute(root: Path, path: str, name: str, change) -> None:
     """Edit one attribute in an array's zarr.json, as a hand or a tool would."""
@@ -297,7 +297,7 @@ def _moved(extent):
 
 # (array, attribute, change): every kind of attribute a reader takes from an array's zarr.json
 ATTRIBUTE_EDITS = [
-    ("insets/env000-d025m/sky_day", "extent_tan", _moved),  # the car's placement (the issue's case)
+    ("insets/env000-d025m/sky_day", "extent_tan", _moved),  # the car's placement
     ("masks/env000-d025m", "extent_tan", _moved),
     ("frames/env000-d025m/car_lights", "extent_tan", _moved),
     ("plates/env001/sky_day", "extent_tan", _moved),
@@ -360,8 +360,8 @@ def test_verify_lists_edited_attributes_and_generate_repairs_them(smoke_collecti
 
 
 def test_benchmark_run_refuses_a_moved_car_in_one_line_and_writes_nothing(smoke_collection, tmp_path):
-    """The issue's case: the car's placement moved in the insets' zarr.json. `benchmark run`
-    exited 0 with AP 0.000 at every distance; now it stops at the first such scene."""
+    """The car's placement moved in the insets' zarr.json: unchecked, `benchmark run` exited 0
+    with AP 0.000 at every distance; it stops at the first such scene."""
     root = _copy(smoke_collection, tmp_path)
     for scene in ("env000-d025m", "env001-d100m"):
         for group in ("sky_day", "sky_night", "car_lights", "ego_lights"):

@@ -217,7 +217,7 @@ BAD = [
     ("not-dot-json", lambda good: dumps_submission(good).encode(), "good.txt", "must end in .json"),
     ("over-5-MB", lambda good: dumps_submission(good).encode() + b" " * (5 * 1024 * 1024), "good.json", "over the 5 MB limit"),
     ("duplicate-name", _edit(lambda s: s.update(name="existing")), "existing.json", "duplicate name"),
-    # issue 13, point 5: what used to pass --check (or break `benchmark leaderboard` later)
+    # what used to pass --check (or break `benchmark leaderboard` later)
     ("name-trailing-newline", _edit(lambda s: s.update(name="good\n")), "good.json", "good.json: name: string holds a control character or line break U+000A"),
     ("submitter-carriage-return", _edit(lambda s: s.update(submitter="b\r")), "good.json", "submitter: string holds a control character or line break U+000D"),
     ("sha-trailing-newline", _edit(lambda s: s["detector"].update(sha256=s["detector"]["sha256"] + "\n")), "good.json",
@@ -241,7 +241,7 @@ BAD = [
     ("same-detections", _edit(_same_detections), "good.json", "conditions.day and conditions.night have the same detections_sha256"),
     ("created-in-the-future", _edit(lambda s: s.update(created_at="9999-12-31T23:59:59Z")), "good.json",
      "created_at 9999-12-31T23:59:59Z is in the future"),
-    # issue 24, point 4: inconsistent fields that passed --check
+    # inconsistent fields that passed --check
     ("n-images-not-one-per-environment", _edit(lambda s: s["conditions"]["day"]["per_distance"][0].update(n_images=99)),
      "good.json", "conditions.day.per_distance: n_images 99 at 25 m, but a collection of 4 environments has 4 images at each distance"),
     ("interval-excludes-od50", _edit(_ci_excludes), "good.json", "conditions.day.od50_m = "),

@@ -23,7 +23,7 @@ from metricscenes.spectral import WAVELENGTHS_NM
 
 # ── the registry does not move ───────────────────────────────────────────────────────────
 
-REGISTRY_SHA256 = {  # computed before the lens work (issue 27), with the specs as they were
+REGISTRY_SHA256 = {  # computed before the lens seam (3358ea4), with the specs as they were
     "cam01": "0241ed23fed235fa85b70a2ce4c99a975e5d090ca637f567a11ddcfca3d6d288",
     "cam02": "a792c983cc38e55b5e505b3476a3ec6e947874a779eb9a8c0fee891f33126c48",
     "cam03": "06aeda10727fcf9b4ef6ee4f6c9d0ae420c79d4d19956897fb3539b3b05a5792",

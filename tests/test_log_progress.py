@@ -1,4 +1,4 @@
-"""Progress in a log (issue 26): where standard error is not a terminal, generate, run and
+"""Progress in a log: where standard error is not a terminal, generate, run and
 sweep print a plain line every 5 % of their units or every 30 s, not a silent rich bar."""
 
 from __future__ import annotations

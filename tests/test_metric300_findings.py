@@ -1,8 +1,7 @@
-"""The paper's findings on metric-300 (50 environments x 6 distances), as issue 25 states its
-acceptance, checked on the published tables in docs/data/metric-300 (written by
-benchmarks/metric300_chain.sh; the commands are in docs/results.md, "metric-300, the paper's
-size"). The thresholds were written before the tables existed; until they are published
-every test here is skipped with that reason."""
+"""The paper's findings on metric-300 (50 environments x 6 distances), checked on the published
+tables in docs/data/metric-300 (written by the metric-300 chain's `benchmark publish` steps; the
+commands are in docs/results.md, "Regenerate metric-300"). The thresholds were written
+before the tables existed; until they are published every test here is skipped with that reason."""
 
 from pathlib import Path
 
@@ -16,7 +15,7 @@ DATA = DOCS_DATA / "metric-300"
 CONDITIONS = {"day", "dusk", "night", "night_regulation"}
 
 pytestmark = pytest.mark.skipif(not (DATA / "sweep.csv").is_file(),
-                                reason="docs/data/metric-300 is not published yet (benchmarks/metric300_chain.sh)")
+                                reason="docs/data/metric-300 is not published yet (benchmarks/metric-300/chain.sh)")
 
 
 def _load(suffix: str) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -48,7 +47,7 @@ def test_ap_falls_with_distance_by_day_for_every_camera_at_paper_parity(paper_pa
 
 
 NIGHT_AT_200_M = (
-    "Measured on metric-300's runs before the tables were published (session 25), as on quick: on "
+    "Measured on metric-300's runs before the tables were published, as on quick: on "
     "the paper's night the two coarsest cameras score a few low boxes on a car 200 m away, AP 0.034 "
     "and 0.038 against 0.003 and 0.030 by day (cam01, cam02); every other camera and distance is "
     "below day (docs/results.md, \"The nights and dusk on metric-300\")")

@@ -1,4 +1,4 @@
-"""Read-only outside one's own output (issue 24, point 3) and the last bad inputs of point 4:
+"""Read-only outside one's own output, and the last bad inputs:
 no command writes into a collection, the leaderboard or another command's folder; two
 writers to one folder are refused; a killed run's staging folder is cleaned; range
 arguments are bounded before anything is listed; five tracebacks became one line.
@@ -83,7 +83,7 @@ def _col_run(world, out):
 
 # (id, which CLI, arguments from the world folder, words of the one line)
 OUT_OF_BOUNDS = [
-    # the issue's cases
+    # a file where a folder or an image belongs
     ("export-over-groundtruth", METRICSCENES, lambda w: ["export", w / "col", w / "col" / "groundtruth.json", "--scene", "env000-d100m"],
      ["OUT", "groundtruth.json: the file name must end in .h5 or .hdf5"]),
     ("export-into-the-collection", METRICSCENES, lambda w: ["export", w / "col", w / "col" / "scene.h5", "--scene", "env000-d100m"],
@@ -225,8 +225,8 @@ def test_a_second_sweep_on_one_folder_is_refused(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 def test_two_runs_on_one_out_and_a_killed_runs_stage(smoke_collection, tmp_path, monkeypatch):
-    """The issue's case: two `benchmark run` on one --out both exited 0 and one result was
-    lost. Now the second is refused naming the first; the first, killed, leaves its stage
+    """Two `benchmark run` on one --out: without the lock both exited 0 and one result was
+    lost; the second is refused naming the first; the first, killed, leaves its stage
     and lock, and the next run on the folder takes the lock over and removes the stage."""
     require_model("yolov5n-dynamic.onnx")
     out = tmp_path / "run"

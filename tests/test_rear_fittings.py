@@ -1,4 +1,4 @@
-"""What a car carries at night (issue 23, point 4): the rear plate lit by its lamp (UN ECE R4)
+"""What a car carries at night: the rear plate lit by its lamp (UN ECE R4)
 and two red rear retro-reflectors (UN ECE R3 class IA) returning the camera car's low beams.
 Opt-in through the manifest (``render.plate_lamp``, ``render.rear_retroreflectors``); one
 tiny render shows them where they belong."""

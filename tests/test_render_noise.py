@@ -1,4 +1,4 @@
-"""benchmarks/render_noise.py's statistics on synthetic captures: noise of known size must
+"""benchmark.measure.render_noise's statistics on synthetic captures: noise of known size must
 come out as that size, whatever the signal's texture."""
 
 from __future__ import annotations
@@ -6,10 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-
-@pytest.fixture(scope="module")
-def render_noise(load_benchmark):
-    return load_benchmark("render_noise")
+from benchmark.measure import render_noise
 
 
 def textured_mean(shape=(256, 384), seed=0) -> np.ndarray:
@@ -20,7 +17,7 @@ def textured_mean(shape=(256, 384), seed=0) -> np.ndarray:
     return mean
 
 
-def test_two_poisson_draws_have_ratio_one(render_noise):
+def test_two_poisson_draws_have_ratio_one():
     # Two independent Poisson draws of the same mean: each differs from the mean by exactly
     # shot noise, so "render noise" over shot noise is 1, overall and in every window.
     rng = np.random.default_rng(1)
@@ -33,7 +30,7 @@ def test_two_poisson_draws_have_ratio_one(render_noise):
     assert stats["used"] == 1.0
 
 
-def test_noise_of_known_fraction_of_shot_noise(render_noise):
+def test_noise_of_known_fraction_of_shot_noise():
     # Renders whose noise is k times the shot noise of their mean, left-out pixels ignored.
     rng = np.random.default_rng(2)
     mean = textured_mean()
@@ -52,7 +49,7 @@ def test_noise_of_known_fraction_of_shot_noise(render_noise):
     assert render_noise.spp_needed(64, 1 / 6) == pytest.approx(16)
 
 
-def test_fitted_convergence(render_noise):
+def test_fitted_convergence():
     alpha, spp = render_noise.fitted_spp([(16, 0.5), (64, 0.25)])
     assert alpha == pytest.approx(0.5)
     assert spp == pytest.approx(36)  # 0.5 at 16 spp, falling as 1/sqrt(spp): 1/3 at 36
@@ -61,33 +58,41 @@ def test_fitted_convergence(render_noise):
     assert spp == pytest.approx(16 * (0.4 * 3) ** (1 / 0.75))
 
 
-def test_collection_check_compares_render_a_as_the_store_writes_it(render_noise, tmp_path):
-    """On a lossy store (quick: BitRound 8, an 8-spectra basis) render A is the collection's
-    array once written as its store writes it (the manifest rendered has no store); another
-    render is not; other render settings are n/a."""
-    from types import SimpleNamespace
 
-    from conftest import REPO
-    from store_codecs import Renders
+def test_used_pixels_leave_out_saturated_and_dark():
+    e_a = np.array([[10.0, 500.0, 2000.0, 3.0]])
+    e_b = np.array([[12.0, 480.0, 900.0, 40.0]])
+    used, left_out = render_noise.used_pixels(e_a, e_b, saturation_e=1000.0, dark_e=25.0)
+    assert used.tolist() == [[False, True, False, False]]  # dark (11 e-), used, saturated in A, dark on average
+    assert left_out == {"saturated": 0.25, "dark": 0.5}
 
-    from metricscenes.geometry import TanExtent
-    from metricscenes.manifest import load_manifest
-    from metricscenes.writer import UnitArrays
 
-    quick = load_manifest(REPO / "manifests" / "quick.yaml")
-    rng = np.random.default_rng(0)
-    cube = rng.gamma(2.0, 0.01, size=(24, 32, 31)).astype(np.float32)
-    extent = TanExtent(-0.1, -0.05, 0.1, 0.05)
-    arrays = UnitArrays(tmp_path, "env000", quick.store.mantissa_bits, quick.store.spectral_basis)
-    arrays.write_radiance("plates", "sky_day", cube, extent)
-    collection = SimpleNamespace(manifest=quick, resolved=SimpleNamespace(arrays=arrays.sha256))
-    layers = {"plate": {path: Renders(cube, cube, extent) for path in arrays.sha256}}
-    rendered = quick.model_copy(update={"store": None})
-    assert render_noise.collection_check(collection, rendered, layers) == "yes"
+def _small_camera():
+    """cam12 with 4x its pixel pitch (480 x 270): quick to simulate."""
+    import yaml
 
-    other = cube.copy()
-    other[0, 0, 0] *= 1.5
-    assert render_noise.collection_check(collection, rendered, {"plate": {p: Renders(other, cube, extent)
-                                                                          for p in arrays.sha256}}) == "NO"
-    finer = rendered.model_copy(update={"render": rendered.render.model_copy(update={"plate_spp": 64})})
-    assert render_noise.collection_check(collection, finer, layers) == "n/a"
+    from benchmark.camera.registry import DATA_DIR, camera_from_dict
+
+    data = yaml.safe_load((DATA_DIR / "cam12.yaml").read_text())
+    data["sensor"].update(pixel_um=5.6)
+    data.update(name="cam12-5.6um", mtf50_group_cy_per_mm=None)
+    return camera_from_dict(data)
+
+
+def test_capture_pair_captures_b_at_as_exposure():
+    from metricscenes.geometry import REFERENCE_EXTENT
+    from metricscenes.radiance import RadianceLayer, SpectralScene
+
+    camera = _small_camera()
+    rng = np.random.default_rng(4)
+    radiance = rng.uniform(0.002, 0.02, (54, 96, 31)).astype(np.float32)
+    scene_a, brighter = (SpectralScene(layers=(RadianceLayer(r, REFERENCE_EXTENT),)) for r in (radiance, 2 * radiance))
+    e_a, e_b, exposure_s, own_b = render_noise.capture_pair(scene_a, scene_a, camera)
+    np.testing.assert_array_equal(e_a, e_b)
+    assert own_b == pytest.approx(exposure_s, rel=1e-6) and 0 < exposure_s <= camera.exposure.max_exposure_s
+    e_a, e_b, exposure_s, own_b = render_noise.capture_pair(scene_a, brighter, camera)
+    np.testing.assert_allclose(e_b, 2 * e_a, rtol=1e-4, atol=1e-3)  # same exposure: twice the light, twice the signal
+    assert own_b < exposure_s  # its own policy would have exposed it shorter
+    hdr = camera.model_copy(update={"exposure": camera.exposure.model_copy(update={"mode": "hdr"})})
+    with pytest.raises(ValueError, match="hdr policy takes two exposures"):
+        render_noise.capture_pair(scene_a, scene_a, hdr)

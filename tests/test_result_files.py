@@ -12,7 +12,6 @@ import pytest
 from typer.testing import CliRunner
 
 from benchmark.result_files import (
-    Od50Bootstrap,
     Od50Cache,
     Od50CacheKey,
     ResultsFileError,
@@ -25,6 +24,7 @@ from benchmark.result_files import (
     write_results,
     write_sweep_record,
 )
+from benchmark.scoring.bootstrap import Od50Bootstrap
 
 REPO = Path(__file__).resolve().parents[1]
 SHA = "f" * 64

@@ -88,7 +88,7 @@ def test_paper_parity_night_is_below_day_everywhere(paper_parity):
     assert paper_findings(*paper_parity)["night_below_day"]
 
 
-# --- issue 23: the paper's night (0.1-1 lux image-plane, every lamp on; reference sweep) ----
+# --- the paper's night (0.1-1 lux image-plane, every lamp on; reference sweep) -------------
 
 PAPER_NIGHT_IS_READ_NOISE_BOUND = (
     "At the paper's night's own image-plane lux our camera is read-noise bound (6.8 e- on the car "
@@ -121,7 +121,7 @@ def test_paper_night_ap_at_25_m_is_useful_for_ten_cameras(tables):
     assert paper_night_findings(*tables)["night_ap_near_useful"]
 
 
-# --- issue 10: dusk and the regulation road (night_regulation; reference sweep) ------------
+# --- dusk and the regulation road (night_regulation; reference sweep) ---------------------
 
 NIGHT_IS_BLIND = (
     "On the regulation road (ego low beams to SAE J1383 / ECE R112, R7 tail lamps, R3 reflectors, "
@@ -156,7 +156,7 @@ def test_night_od50_lies_inside_the_measured_range_for_ten_cameras(tables):
 
 def test_cameras_of_one_published_mtf50_group_differ_by_several_sds_by_day():
     """The paper: scores "differed by as much as three standard deviations when the MTF50 was
-    equal". docs/data/mtf50-groups.csv (benchmarks/mtf50_groups.py on the reference sweep):
+    equal". docs/data/mtf50-groups.csv (`benchmark publish mtf50-groups` on the reference sweep):
     pairs of one published group, paired bootstrap; by day some pair differs by more than 2 SD,
     and the table's OD50s are the reference sweep's."""
     groups = pd.read_csv(DATA / "mtf50-groups.csv")
@@ -172,7 +172,7 @@ def test_cameras_of_one_published_mtf50_group_differ_by_several_sds_by_day():
 def test_the_gpus_collection_scores_as_the_cpus():
     """metric-300's first 8 environments rendered by cuda_ad_spectral (an H100) and by
     llvm_ad_spectral (this CPU), swept alike and compared camera by camera (paired bootstrap):
-    docs/data/backend-scores.csv (benchmarks/backend_scores.py; docs/performance.md, "On a GPU").
+    docs/data/backend-scores.csv (`benchmark publish backend-scores`; docs/performance.md, "On a GPU").
     Each ΔOD50 lies within either collection's own OD50 SD, no AP differs by 0.1, and the AP
     differences called are about as many as a 95 % interval calls by chance."""
     table = pd.read_csv(DATA / "backend-scores.csv", keep_default_na=False, na_values=[""])

@@ -1,7 +1,7 @@
 """Camera specs a sensor cannot have are refused in one line that names the field, the value,
-the plausible range and the likely unit mistake (issue 26, point 4); values that are possible
+the plausible range and the likely unit mistake; values that are possible
 but unusual are warned about. Duplicate YAML keys, impossible QE tables and a user spec that
-takes a registry camera's name are refused too (issue 24, point 4). Each refusal: exit code
+takes a registry camera's name are refused too. Each refusal: exit code
 2, one line, nothing created."""
 
 from __future__ import annotations

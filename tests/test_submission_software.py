@@ -1,5 +1,5 @@
 """A submission says what decided its bytes (versions, the CPU's kernel class), and
-``submit --check`` warns where this machine differs (issue 24, point 1)."""
+``submit --check`` warns where this machine differs, and passes."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 from benchmark.cli.main import app
 from benchmark.leaderboard.submission import software_differences
 from benchmark.leaderboard.validate import validate_submission
+from metricscenes import numeric_pins
 from metricscenes.numeric_pins import isa_class, package_versions
 
 REPO = Path(__file__).resolve().parents[1]
@@ -27,7 +28,21 @@ def _with_software(versions: dict, isa: str) -> dict:
 def test_the_same_software_is_no_difference_and_validates():
     sub = _with_software(package_versions(), isa_class())
     assert validate_submission(sub, source="s") is sub and software_differences(sub) == []
-    assert software_differences(json.loads(REFERENCE.read_text())) == []  # made before it was recorded: silent
+
+
+@pytest.mark.parametrize("here", ["avx2", "avx512", "other"])
+def test_a_reference_submission_is_checked_the_same_on_every_kind_of_machine(here, monkeypatch, tmp_path):
+    """The committed references were made on an AVX2 machine: elsewhere the check names the
+    machine as the one difference, warns and accepts; it never fails for the host's CPU."""
+    monkeypatch.setattr(numeric_pins, "isa_class", lambda flags=None: here)
+    reference = json.loads(REFERENCE.read_text())
+    made_on = reference["software"]["isa_class"]
+    expected = [] if here == made_on else [f"made on an x86-64 {made_on} machine (here {here})"]
+    assert software_differences(reference) == expected
+    assert validate_submission(reference, source="s") is reference
+    res = CliRunner().invoke(app, ["submit", "--check", str(REFERENCE), "--leaderboard", str(REPO / "leaderboard")])
+    assert res.exit_code == 0, res.output
+    assert ("warning:" in res.output) == bool(expected)
 
 
 @pytest.mark.parametrize(("versions", "expected"), [

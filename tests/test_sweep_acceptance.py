@@ -86,7 +86,7 @@ def test_bad_input():
         paper_findings(table[table.condition == "day"], od)
 
 
-# --- issue 10: night and dusk criteria -----------------------------------------------------
+# --- night and dusk criteria --------------------------------------------------------------
 
 def night_tables(night_ap, dusk_factor=0.75):
     """Day AP falls from 0.9; dusk is ``dusk_factor`` of day; night AP is ``night_ap(cam, d)``;
@@ -127,7 +127,7 @@ def test_night_findings_need_dusk_rows():
         night_findings(table[table["condition"] != "dusk"], od)
 
 
-# --- issue 23/25: the paper's night below day, where either light sees the car ---------------
+# --- the paper's night below day, where either light sees the car -------------------------
 
 def test_paper_night_below_day_where_seen_ignores_cells_neither_light_sees():
     table, od = night_tables(lambda cam, d: 0.4 * np.exp(-d / 120))

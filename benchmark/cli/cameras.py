@@ -92,7 +92,7 @@ def show_command(
     view, IFOV, Nyquist, MTF50 through the whole chain, saturation, dynamic range, SNR at
     100 lux, and the datasheet figures measured on its photon transfer (dynamic range,
     SNR10 and SNR1 illuminance, HDR transitions); warnings."""
-    from benchmark.camera.figures import camera_figures, camera_warnings, figure_rows
+    from benchmark.measure.figures import camera_figures, camera_warnings, figure_rows
 
     cam = _load([name])[0]
     try:

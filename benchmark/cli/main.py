@@ -12,6 +12,7 @@ from rich.table import Table
 
 from benchmark.cli.cameras import app as cameras_app
 from benchmark.cli.help import HELP_SETTINGS
+from benchmark.cli.publish import app as publish_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
@@ -23,6 +24,7 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
                   rich_markup_mode=None, context_settings=HELP_SETTINGS,  # help over the terminal's width
                   help="How well does a camera let a detector see cars? Simulate, detect, score.")
 app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show, measure MTF50.")
+app.add_typer(publish_app, name="publish", help="The tables of docs/data and docs/results.md, made from sweeps and collections.")
 cli_detect.register(app)
 cli_leaderboard.register(app)
 compare.register(app)

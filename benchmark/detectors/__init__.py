@@ -7,27 +7,17 @@ Detection(class_id=2, class_name='car', score=0.70, box_xyxy=(468.0, 80.0, 690.0
 See docs/detection.md for the families' conventions and the input-size policies.
 """
 
-from benchmark.detectors.base import (
-    COCO80_NAMES,
-    Detection,
-    Detector,
-    DetectorError,
-    coco80_class_id,
-    coco_category_id,
-)
+from benchmark.detectors.base import Detection, Detector, DetectorError
 from benchmark.detectors.loader import load_detector
 from benchmark.detectors.onnx_detector import OnnxDetector
 from benchmark.detectors.registry import ModelEntry, registry
 
 __all__ = [
-    "COCO80_NAMES",
     "Detection",
     "Detector",
     "DetectorError",
     "ModelEntry",
     "OnnxDetector",
-    "coco80_class_id",
-    "coco_category_id",
     "load_detector",
     "registry",
 ]

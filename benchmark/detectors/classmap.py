@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Sequence
 
-from benchmark.detectors.base import COCO80_NAMES
+from benchmark.coco import COCO80_NAMES
 
 DROP = "-"
 

@@ -16,7 +16,8 @@ import numpy as np
 import onnxruntime as ort
 
 from benchmark.detectors import yolov5, yolov8, yolox
-from benchmark.detectors.base import COCO80_NAMES, Detection, DetectorError
+from benchmark.coco import COCO80_NAMES
+from benchmark.detectors.base import Detection, DetectorError
 from benchmark.detectors.family import N_CLASSES, Family, grid_cells
 from benchmark.detectors.letterbox import Placement, letterbox, pad_to_stride
 from benchmark.detectors.nms import batched_nms

@@ -1,4 +1,4 @@
-"""Acceptance checks of a sweep against the paper's qualitative findings (issue 5).
+"""Acceptance checks of a sweep against the paper's qualitative findings.
 
 Liu et al., EI 2023 report, for the 13 cameras:
 
@@ -12,9 +12,9 @@ Liu et al., EI 2023 report, for the 13 cameras:
    across cameras >= 0.6 (infinite OD50s rank above every finite one).
 
 :func:`paper_findings` returns each verdict (bool) with the statistic behind it (float);
-:func:`night_findings` does the same for the night and dusk criteria of issue 10 (now judged
-on the unlit regulation road, ``night_regulation``), :func:`paper_night_findings` for the
-paper's own night (issue 23).
+:func:`night_findings` does the same for night and dusk criteria on the unlit regulation road
+(``night_regulation``), :func:`paper_night_findings` for the paper's own night, and
+:func:`od50_sd_shrinks` compares two collections' bootstrap SDs.
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ NIGHT_OD50_INSIDE_MIN_CAMERAS = 10
 def night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", dusk: str = "dusk",
                    night: str = "night", near_m: float = 25.0,
                    measured_range_m: tuple[float, float] = (25.0, 200.0)) -> dict[str, bool | float | int]:
-    """Issue 10's night criteria on a sweep's tables (every camera of the table):
+    """Night and dusk criteria on a sweep's tables (every camera of the table):
 
     - ``night_ap_near_useful``: night AP at ``near_m`` >= 0.2 for every camera
       (``night_ap_near_min``: the smallest);
@@ -140,7 +140,7 @@ PAPER_NIGHT_USEFUL_MIN_CAMERAS = 10
 def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = "day", night: str = "night",
                          near_m: float = 25.0, seen_ap: float = 0.1) -> dict[str, bool | float | int]:
     """The paper's night (Liu et al. 2023: 0.1-1 lux mean image-plane illuminance, every lamp
-    on), judged as issue 23 asks, every camera of the table:
+    on), judged on every camera of the table:
 
     - ``night_ap_near_useful``: night AP at ``near_m`` >= 0.15 for at least 10 cameras
       (``night_ap_near_useful_cameras``: how many);
@@ -181,8 +181,9 @@ def paper_night_findings(table: pd.DataFrame, od50: pd.DataFrame, *, day: str = 
 
 
 def od50_sd_shrinks(od50: pd.DataFrame, smaller_collection_od50: pd.DataFrame, *, condition: str = "day") -> dict:
-    """A larger collection's bootstrap OD50 SDs against a smaller one's (issue 25: metric-300's
-    day SDs below quick's for at least 11 of 13 cameras), camera by camera under ``condition``.
+    """A larger collection's bootstrap OD50 SDs against a smaller one's (metric-300's day SDs
+    below quick's for at least 11 of 13 cameras: tests/test_metric300_findings.py), camera by
+    camera under ``condition``.
     Cameras whose OD50 is censored on either side (its SD measures the edge of the distances,
     not the spread) are counted apart, not compared.
 

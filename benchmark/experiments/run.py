@@ -45,6 +45,7 @@ from benchmark.detectors.policy import parse_input_size
 from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
     CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
 )
+from benchmark.scoring.ap import AP_SCORE_THRESHOLD
 from metricscenes.files import sha256_file
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
@@ -53,10 +54,9 @@ from benchmark.result_files import (
 )
 
 # How the collection's layers are composited for a camera (metricscenes.store.Collection.radiance):
-# "car" since session 12, the inset at its own resolution only around the car. Runs made before
-# it recorded none, so a sweep does not take them for this composite's.
+# "car" since v0.1.0a5 (CHANGELOG.md), the inset at its own resolution only around the car. Runs made
+# before it recorded none, so a sweep does not take them for this composite's.
 COMPOSITE = "car"
-AP_SCORE_THRESHOLD = 0.001  # COCO evaluation wants the whole precision-recall curve
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.
 FORBIDDEN_IN_NAMES = ("..", "/", "\\", "\0", "\n", "\r")
@@ -559,7 +559,7 @@ class _CameraRun:
         from PIL import Image
 
         from benchmark.camera.pipeline import simulate
-        from benchmark.detectors import coco_category_id
+        from benchmark.coco import coco_category_id
 
         camera, captures, timings = self.camera, self.captures, self.timings
         if record is not None:

@@ -48,12 +48,12 @@ import pandas as pd
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
 from benchmark.result_files import (
-    SWEEP_FORMAT, CollectionRecord, DetectorRecord, Od50Bootstrap, Od50Cache, Od50CacheKey,
+    SWEEP_FORMAT, CollectionRecord, DetectorRecord, Od50Cache, Od50CacheKey,
     Od50Row, ResultsFileError, RunResults, Subset, SweepExposure, SweepRecord, SweepRow, SweepRun,
     read_od50_cache, read_od50_table, read_results, read_sweep_table, write_od50_cache, write_od50_table,
     write_sweep_record, write_sweep_table,
 )
-from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, Od50Bootstrap
 from benchmark.scoring.od50 import od50_censoring
 from metricscenes.manifest import parse_illuminance_condition
 

@@ -19,9 +19,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from benchmark.result_files import (
-    RESULTS_FORMAT, DetectorRecord, Od50Bootstrap, Od50CacheKey, ResultsFileError, RunFolder, read_od50_cache, read_results,
+    RESULTS_FORMAT, DetectorRecord, Od50CacheKey, ResultsFileError, RunFolder, read_od50_cache, read_results,
 )
-from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, Od50Bootstrap
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
 from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
@@ -210,7 +210,7 @@ def build_submission(
     }  # fmt: skip
     if notes:
         submission["notes"] = notes
-    if first.numerics is not None:  # runs made since session 12 say what decided their bytes
+    if first.numerics is not None:  # runs made since v0.1.0a5 say what decided their bytes
         submission["software"] = {"versions": first.numerics["versions"], "isa_class": first.numerics["isa_class"]}
     if spec.sha256() != first.camera.spec_sha256:
         raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")

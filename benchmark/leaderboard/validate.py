@@ -228,7 +228,7 @@ def _check_detector(data: dict, source: str) -> None:
     from benchmark.detectors import registry
     from benchmark.detectors.onnx_detector import FAMILIES
     from benchmark.detectors.policy import parse_input_size
-    from benchmark.experiments.run import AP_SCORE_THRESHOLD
+    from benchmark.scoring.ap import AP_SCORE_THRESHOLD
 
     det = data["detector"]
     models = registry()

@@ -1,1 +1,2 @@
-"""Measurement of a camera: test targets and the ISO 12233 slanted-edge MTF."""
+"""Measurement of a camera: test targets, the ISO 12233 slanted-edge MTF, the photon transfer
+and the figures a spec implies (``benchmark cameras show``)."""

@@ -22,6 +22,9 @@ import numpy as np
 BACKENDS = ("faster-coco-eval", "pycocotools")
 MAX_DETS = (1, 10, 100)
 ALL_AREAS = [0.0, 1e10]
+# The score a detection needs to be kept for AP: COCO evaluation wants the whole precision-recall
+# curve, so runs keep every detection down to it and a submission's detections must say so.
+AP_SCORE_THRESHOLD = 0.001
 
 
 def _check_backend(backend: str) -> None:

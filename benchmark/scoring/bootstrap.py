@@ -28,13 +28,31 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from benchmark.result_files import Od50Bootstrap
+from benchmark.record_base import Censored, JsonFloat, Record
 from benchmark.scoring.ap import ALL_AREAS, MAX_DETS, ap_by_distance, images_by_distance
 from benchmark.scoring.od50 import od50, od50_censoring
 
 REC_THRS = np.linspace(0.0, 1.00, 101)  # COCO recall thresholds
 IOU_THRS = np.linspace(0.5, 0.95, 10)
 BOOTSTRAP_RESAMPLES = 1000  # the one default: run report, sweep, leaderboard and compare (printed with results)
+
+
+class Od50Bootstrap(Record):
+    """OD50 with its bootstrap spread over environments (:func:`bootstrap_od50`); the record
+    ``od50.json`` caches (:class:`benchmark.result_files.Od50Cache`).
+
+    Caches written before censoring was recorded lack ``censored`` and ``bound_m``; hand-made
+    ones may lack the counts.
+    """
+
+    od50_m: JsonFloat  # of the full set, m; +inf where AP never falls to 0.5; extrapolated where censored
+    sd_m: JsonFloat  # SD (ddof 1) of the finite resampled OD50s, m; NaN with fewer than two
+    ci95_m: tuple[JsonFloat, JsonFloat]  # percentile interval (95 % by default), m; an end may be +inf
+    n_resamples: int
+    n_environments: int | None = None  # the environments resampled (each keeps all its distances)
+    n_infinite: int | None = None  # resamples whose OD50 is +inf (they still enter the interval)
+    censored: Censored | None = None  # of the full set (benchmark.scoring.od50.od50_censoring)
+    bound_m: float | None = None  # the farthest (">") or nearest ("<") measured distance; None when not censored
 
 
 def resample_environments(groundtruth: dict, detections: list[dict], environments) -> tuple[dict, list[dict]]:
@@ -165,7 +183,7 @@ def bootstrap_od50(
 ) -> Od50Bootstrap:
     """OD50 (from the full set, ``backend``) with its bootstrap SD and percentile CI over environments.
 
-    Returns an :class:`~benchmark.result_files.Od50Bootstrap`: ``od50_m``, ``sd_m``,
+    Returns an :class:`Od50Bootstrap`: ``od50_m``, ``sd_m``,
     ``ci95_m`` (lo, hi), ``n_resamples``, ``n_environments``, ``n_infinite``, ``censored``
     and ``bound_m`` ("", ">" or "<" of the full set and its bound, :func:`od50_censoring`);
     ``sd_m`` is the SD (ddof 1) of the finite resampled OD50s, ``n_infinite`` counts

@@ -1,5 +1,5 @@
 """Is the car found? Per-distance detection rates at a working threshold, and what
-the detector mistakes the car for (DESIGN §4; the scene issue's acceptance).
+the detector mistakes the car for (DESIGN §4; docs/scenes.md, "Detectability").
 
 Unlike AP, which sweeps every threshold, this answers the practical question at one
 operating point: is there a ``car`` detection with score ≥ ``score_threshold`` whose
@@ -14,8 +14,7 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-from benchmark.detectors.base import COCO80_NAMES, coco80_class_id
-from benchmark.detectors.nms import box_iou
+from benchmark.coco import COCO80_NAMES, box_iou, coco80_class_id
 
 CAR_CATEGORY_ID = 3
 

@@ -1,0 +1,97 @@
+"""Does the inset's window show in a camera's image? The seam figures of one scene (docs/scenes.md,
+"The inset seam"; measured over a collection by ``benchmarks/studies/composite_fidelity.py --seam``).
+
+The scene is captured noise-free (sensor noise off, D65 white balance: what is left is the
+composite and the render's own noise) with the inset composited as the store gives it, and the
+car-less plate alone at the same exposure; the CIELAB difference ΔE*ab per pixel of the two
+sRGB images is zero outside the window, and away from the car it is what the window shows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from metricscenes.store import Collection
+
+SEAM_BAND_PX = 3  # band width, camera pixels
+SEAM_GAP_PX = 1  # pixels left out inward of the feather ramp's end
+
+
+def srgb8_to_lab(rgb8: np.ndarray) -> np.ndarray:
+    """CIELAB (D65 white) of 8-bit sRGB (IEC 61966-2-1), float64 (..., 3)."""
+    c = rgb8.astype(np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    m = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]])
+    xyz = lin @ m.T / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > (6 / 29) ** 3, np.cbrt(xyz), xyz / (3 * (6 / 29) ** 2) + 4 / 29)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], axis=-1)
+
+
+def seam_check(collection: Collection, scene_id: str, condition: str, camera, inset_resolution: str) -> dict:
+    """The seam figures of one scene in one camera's noise-free image: the per-pixel ΔE*ab
+    between the composite's image and the car-less plate's (same exposure and white balance),
+    which is zero outside the window, in bands along the window's edges just inward of its
+    feather ramp (mean, and the worst line along an edge), and over the whole window's
+    background (pixels farther from the car than :func:`metricscenes.radiance.car_sharpness`
+    keeps sharp: mean and 99th percentile); and the detail ratio there, mean |∇L*| of the
+    composite over the plate's (1: as sharp as the plate)."""
+    from benchmark.camera.exposure import with_exposure
+    from benchmark.camera.pipeline import sensor_extent, simulate
+    from benchmark.camera.spec import ExposureSpec
+    from metricscenes.radiance import SpectralScene, _overlap_matrix, car_sharpness
+
+    if camera.optics.distortion is not None:
+        raise ValueError(f"{camera.name}: the seam check maps the window without lens distortion; "
+                         "choose another camera")
+    # One white balance for both images (grey world would follow the car's few pixels).
+    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
+    camera = camera.model_copy(update={"isp": isp})
+    scene = collection.radiance(scene_id, condition, inset_resolution=inset_resolution)
+    plate, inset = scene.layers[0], scene.layers[1]
+    composite = simulate(scene, camera, seed=0, noise=False)
+    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
+    alone = simulate(SpectralScene(layers=(plate,)), fixed, seed=0, noise=False)
+    lab_c, lab_p = srgb8_to_lab(composite.rgb8), srgb8_to_lab(alone.rgb8)
+    de = np.linalg.norm(lab_c - lab_p, axis=-1)
+    # The window on the camera's grid, and its background: wholly inside, away from the car.
+    rows, cols = de.shape
+    e = sensor_extent(camera, scene.extent)
+    i = inset.extent
+    ox = _overlap_matrix(i.x0, i.x1, inset.radiance.shape[1], e.x0, e.x1, cols)
+    oy = _overlap_matrix(i.y0, i.y1, inset.radiance.shape[0], e.y0, e.y1, rows)
+    mask, _ = collection.mask(scene_id)
+    near_car = car_sharpness(mask, i, plate.pixel_tan).astype(np.float64)
+    near_car = oy @ (ox @ near_car.T).T
+    inside = np.outer(np.asarray(oy.sum(axis=1)).ravel(), np.asarray(ox.sum(axis=1)).ravel()) > 1 - 1e-6
+    background = inside & (near_car == 0)
+    sx, sy = cols / e.width, rows / e.height
+    x0, x1 = (i.x0 - e.x0) * sx, (i.x1 - e.x0) * sx
+    y0, y1 = (i.y0 - e.y0) * sy, (i.y1 - e.y0) * sy
+    rx, ry = inset.feather * (x1 - x0), inset.feather * (y1 - y0)
+    c0, c1 = int(np.ceil(x0 + rx)) + SEAM_GAP_PX, int(np.floor(x1 - rx)) - SEAM_GAP_PX
+    r0, r1 = int(np.ceil(y0 + ry)) + SEAM_GAP_PX, int(np.floor(y1 - ry)) - SEAM_GAP_PX
+    n = SEAM_BAND_PX
+    bands = []  # (ΔE, background) over a band, lines along the edge first
+    if x0 > 0:
+        bands.append((de[r0:r1, c0:c0 + n], background[r0:r1, c0:c0 + n]))
+    if x1 < cols:
+        bands.append((de[r0:r1, c1 - n:c1], background[r0:r1, c1 - n:c1]))
+    if y0 > 0:
+        bands.append((de[r0:r0 + n, c0:c1].T, background[r0:r0 + n, c0:c1].T))
+    if y1 < rows:
+        bands.append((de[r1 - n:r1, c0:c1].T, background[r1 - n:r1, c0:c1].T))
+    if not background.any():  # the window is all within the car's few plate pixels (e.g. smoke's far cars)
+        raise ValueError(f"{scene_id}: no pixel of the window lies away from the car on {camera.name}'s grid")
+    border = np.concatenate([d[b] for d, b in bands] + [np.zeros(0)])
+    lines = [float(d[k][b[k]].mean()) for d, b in bands for k in range(d.shape[0]) if b[k].any()] or [np.nan]
+    grad = [np.abs(np.diff(lab[..., 0], axis=a)) for lab in (lab_c, lab_p) for a in (0, 1)]
+
+    def detail(along_rows: np.ndarray, along_cols: np.ndarray) -> float:
+        return float(along_rows[background[1:] & background[:-1]].mean()
+                     + along_cols[background[:, 1:] & background[:, :-1]].mean())
+
+    return {"border_px": int(border.size), "border_de": float(border.mean()) if border.size else np.nan,
+            "border_de_max_line": max(lines), "window_px": int(background.sum()),
+            "window_de": float(de[background].mean()), "window_de_p99": float(np.percentile(de[background], 99)),
+            "outside_de": float(de[~inside].mean()),
+            "detail_ratio": detail(grad[0], grad[1]) / detail(grad[2], grad[3])}
