@@ -15,7 +15,7 @@ DOCS = REPO / "docs"
 ARCHITECTURE = DOCS / "architecture.md"
 PACKAGES = ("metricscenes", "benchmark")
 FILE_SUFFIXES = {"yaml", "yml", "json", "jsonl", "csv", "lock", "png", "svg", "h5", "hdf5", "html", "npz", "txt", "md",
-                 "py", "sh", "env", "onnx", "zarr"}
+                 "py", "sh", "env", "onnx", "zarr", "started"}
 
 
 # --- the source --------------------------------------------------------------------------------------------
