@@ -21,7 +21,7 @@ in cycles per mrad in object space (``_cy_per_mrad``: × focal length / 1000, wh
 cameras whose focal lengths differ). OD50 may be **censored**: where AP
 does not cross 0.5 inside the measured distances the number is an extrapolation (or +inf),
 and what is reported is a bound, "> 200 m" or "< 25 m" (:mod:`benchmark.scoring.od50`,
-docs/detection.md). The records keep the number; :meth:`RunResults.od50_censoring`,
+docs/scoring.md). The records keep the number; :meth:`RunResults.od50_censoring`,
 ``Od50Bootstrap.censored`` and ``Od50Row.censored`` say whether it is a bound.
 
 Bytes. A file holds the fields its writer set, in the order the model declares them (an
@@ -69,6 +69,8 @@ class DistanceAP(Record):
     ap: float  # COCO AP@[.50:.05:.95], unitless; NaN where no image at this distance holds a car
     ap50: float  # AP at IoU 0.5
     n_images: int  # images (environments) at this distance
+    miss_rate: float | None = None  # at the working threshold (benchmark.scoring.FOUND_SCORE, FOUND_IOU); absent in older runs
+    false_positives_per_image: float | None = None  # car detections at that threshold that do not find the car, per image
 
 
 class CameraRecord(Record):
@@ -280,6 +282,10 @@ class Od50Row(Record):
     focal_length_mm: float | None = None  # as SweepRow's
     mtf50_cy_per_mrad: JsonFloat | None = None
     censored: Censored | None = None  # absent in sweeps written before censoring was recorded
+    ap_range_m: JsonFloat | None = None  # area under AP vs distance, m (Od50Bootstrap); absent in older sweeps
+    ap_range_sd_m: JsonFloat | None = None
+    ap_range_ci95_lo_m: JsonFloat | None = None
+    ap_range_ci95_hi_m: JsonFloat | None = None
 
 
 TABLE_COLUMNS = list(SweepRow.model_fields)

@@ -178,7 +178,8 @@ def test_cli_says_both_blind(tmp_path):
     assert sorted(p.name for p in tmp_path.rglob("*")) == before  # no --out: nothing written
 
 
-def test_too_few_cars_to_call_anything_is_said_not_taken_for_blindness():
+def test_too_few_cars_to_call_anything_is_said_not_taken_for_blindness(monkeypatch):
+    monkeypatch.setattr("benchmark.scoring.sample.MIN_ENVIRONMENTS", 2)  # (the found-cars rule alone, below the minimum sample)
     gt, _ = synthetic_collection(2, seed=7)  # two environments: two cars a distance, as on smoke
     perfect = [{"image_id": a["image_id"], "category_id": 3, "bbox": list(a["bbox"]), "score": 0.9}
                for a in gt["annotations"]]
@@ -187,3 +188,91 @@ def test_too_few_cars_to_call_anything_is_said_not_taken_for_blindness():
     assert res["verdict"].endswith("; with 2 cars per distance no difference at a distance can be called "
                                    "(3 found cars needed)")
     assert "blind" not in res["verdict"]
+
+
+def _perfect(gt, up_to_m=1e9):
+    """Exact car boxes of score 0.9 up to ``up_to_m``, none beyond."""
+    distance = {im["id"]: im["distance_m"] for im in gt["images"]}
+    return [{"image_id": a["image_id"], "category_id": 3, "bbox": list(a["bbox"]), "score": 0.9}
+            for a in gt["annotations"] if distance[a["image_id"]] <= up_to_m]
+
+
+def test_two_environments_refuse_in_one_line_naming_the_minimum():
+    """As on `first`: a camera that finds every car against one that finds none beyond 50 m. The
+    interval alone would call it; the verdict is the one line, the table is still there."""
+    from benchmark.scoring import MIN_ENVIRONMENTS
+
+    gt, _ = synthetic_collection(2, seed=7)
+    res = compare_runs(side(gt, _perfect(gt)), side(gt, _perfect(gt, 50.0), name="camB"), n_resamples=100)
+    assert res["verdict"] == (f"sample too small: 2 environments per distance, at least {MIN_ENVIRONMENTS} needed for a "
+                              "verdict (docs/scoring.md)")
+    assert res["sample_too_small"] and res["environments_per_distance"] == 2 and res["min_environments"] == MIN_ENVIRONMENTS
+    assert len(res["per_distance"]) == 6 and not any(r["resolved"] for r in res["per_distance"])
+    assert not res["delta_ap_range"]["resolved"] and res["delta_ap_range"]["ci95_m"][0] > 0  # excluded 0, not called
+
+
+def test_cli_refuses_on_two_environments_and_prints_the_table(tmp_path):
+    from benchmark.cli.main import app
+
+    gt, _ = synthetic_collection(2, seed=7)
+    for name, dets in (("a", _perfect(gt)), ("b", _perfect(gt, 50.0))):
+        folder = tmp_path / name
+        folder.mkdir()
+        results = {"camera": {"name": f"cam-{name}"}, "condition": "day", "collection": {"manifest_sha256": SHA}}
+        (folder / "results.json").write_text(json.dumps(results))
+        (folder / "groundtruth.json").write_text(json.dumps(gt))
+        (folder / "detections.json").write_text(json.dumps(dets))
+    res = CliRunner().invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "50"],
+                             env={"COLUMNS": "250"})
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    assert lines[-1].startswith("sample too small: 2 environments per distance, at least ")
+    assert "2/2" in res.output and "0/2" in res.output and "FP/image" in res.output and "AP range" in res.output
+
+
+def test_censored_od50_is_compared_by_ap_range():
+    """A finds every car to 200 m (OD50 > 200 m), B none beyond 100 m: ΔOD50 is not measured, the
+    ΔAP range is (200 vs 125 m) and carries the verdict."""
+    gt, _ = synthetic_collection(10, seed=7)
+    res = compare_runs(side(gt, _perfect(gt), name="camA"), side(gt, _perfect(gt, 100.0), name="camB"), n_resamples=100)
+    assert res["delta_od50"]["delta_m"] is None and res["a"]["censored"] == ">" and res["b"]["censored"] == ""
+    rng = res["delta_ap_range"]
+    assert (res["a"]["ap_range_m"], res["b"]["ap_range_m"]) == pytest.approx((200.0, 125.0))
+    assert rng["delta_m"] == pytest.approx(75.0) and rng["resolved"]
+    assert res["verdict"].startswith("camA detects cars farther than camB by day: AP range 200 vs 125 m, 75 ± 0 m more "
+                                     "(95 %: 75–75 m; OD50 > 200 m vs 125.0 m: outside the measured distances")
+    same = compare_runs(side(gt, _perfect(gt), name="camA"), side(gt, _perfect(gt), name="camB"), n_resamples=50)
+    assert same["verdict"].startswith("no difference resolved between camA and camB by day: ΔAP range = +0 ± 0 m")
+
+
+def test_rows_carry_miss_rate_false_positives_and_hold_their_points(run20):
+    gt, dets = run20
+    res = compare_runs(side(gt, dets), side(gt, degraded(gt, dets), name="camB"), n_resamples=100)
+    for r in res["per_distance"]:
+        assert r["ci95"][0] <= r["delta_ap"] <= r["ci95"][1]
+        assert r["miss_rate_a"] == pytest.approx(1 - r["found_a"] / r["n_cars"]) and r["fp_per_image_a"] >= 0
+        assert r["miss_rate_b"] >= r["miss_rate_a"]  # B lost half its car boxes
+    for block in (res["delta_od50"], res["delta_ap_range"]):
+        assert block["ci95_m"][0] <= block["delta_m"] <= block["ci95_m"][1]
+
+
+def test_a_camera_against_itself_reseeded_is_within_its_interval():
+    """Capture noise is inside the interval: environments are resampled with their one capture
+    each, so the spread of the paired bootstrap covers a reseed (docs/scoring.md, "What is
+    resampled"). On 12 environments of a synthetic camera, pairs of sensor-noise seeds: the
+    bootstrap SD of ΔAP range is the reseeds' own spread (√2 × their SD) within 40 %, and the
+    95 % intervals hold 0 in most pairs."""
+    from benchmark.scoring import ap_by_distance, ap_range
+
+    gt, _ = synthetic_collection(12, seed=1, noise_seed=0, half_range_m=110.0)
+    runs = [synthetic_collection(12, seed=1, noise_seed=k, half_range_m=110.0)[1] for k in range(12)]
+    ranges = []
+    for dets in runs:
+        rows = ap_by_distance(gt, dets)
+        ranges.append(ap_range([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
+    pairs = [compare_runs(side(gt, runs[k]), side(gt, runs[k + 1], name="reseeded"), n_resamples=200, seed=k)
+             for k in range(0, 12, 2)]
+    spread = np.sqrt(2) * np.std(ranges, ddof=1)
+    assert 0.6 * spread < np.mean([p["delta_ap_range"]["sd_m"] for p in pairs]) < 1.4 * spread
+    held = [p["delta_ap_range"]["ci95_m"][0] <= 0 <= p["delta_ap_range"]["ci95_m"][1] for p in pairs]
+    assert sum(held) >= 5, held

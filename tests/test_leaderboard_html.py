@@ -119,8 +119,9 @@ MEASURE = ("<script>window.addEventListener('load', () => { const d = document.d
 
 
 def test_committed_table_fits_1400_px_without_scrolling_sideways(chromium_works, tmp_path):
-    """The committed leaderboard (15 columns: three conditions, MTF50 in both units, focal length,
-    field of view) fits a 1400 px wide window: neither the page nor a table scrolls sideways."""
+    """The committed leaderboard (18 columns: four conditions' OD50, day and night AP range, MTF50
+    in both units, focal length, field of view) fits a 1400 px wide window: neither the page nor a
+    table scrolls sideways."""
     import json
 
     text = (REPO / "leaderboard" / "index.html").read_text(encoding="utf-8")
@@ -133,4 +134,4 @@ def test_committed_table_fits_1400_px_without_scrolling_sideways(chromium_works,
     widths = json.loads(found.group(1))
     assert widths["page"][0] <= widths["page"][1], widths
     assert widths["tables"] and all(scroll <= client for scroll, client in widths["tables"]), widths
-    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text
+    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text and "Night AP range (m)" in text

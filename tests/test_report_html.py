@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from benchmark.experiments import report as report_module
+from benchmark.scoring import MIN_ENVIRONMENTS
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from test_sweep_cache import make_fake_sweep  # the fake runs (tests/ is on sys.path)
 
@@ -70,9 +71,16 @@ def test_sweep_report_table_matches_od50_csv(sweep_dir, page):
     table = _html_table(page.split("<h2>Results</h2>", 1)[1])
     assert len(table) == 8 and list(table.columns[:8]) == ["camera", "condition", "MTF50 (cy/mm)", "MTF50 (cy/mrad)",
                                                            "focal length (mm)", "FOV (°)", "OD50 ± SD (m)", "95 % interval (m)"]
+    assert (od50.n_environments == 4).all() and MIN_ENVIRONMENTS > 4  # too few: every figure is marked
     for _, row in od50.iterrows():
         shown = table[(table.camera == row.camera) & (table.condition == row.condition)].iloc[0]
-        assert shown["OD50 ± SD (m)"] == f"{row.od50_m:.1f} ± {row.sd_m:.1f}" or not np.isfinite(row.od50_m)
+        assert shown["OD50 ± SD (m)"] == f"{row.od50_m:.1f} ± {row.sd_m:.1f}†" or not np.isfinite(row.od50_m)
+        assert shown["AP range ± SD (m)"] == f"{row.ap_range_m:.1f} ± {row.ap_range_sd_m:.1f}†"
+        assert shown["AP range 95 % (m)"] == f"[{row.ap_range_ci95_lo_m:.1f}, {row.ap_range_ci95_hi_m:.1f}]"
+    results = page.split("<h2>Results</h2>", 1)[1]
+    assert results.startswith("<p class='verdict'>sample too small: 4 environments per distance, at least "
+                              f"{MIN_ENVIRONMENTS} needed for a verdict (docs/scoring.md)")
+    assert f"† from fewer than {MIN_ENVIRONMENTS} environments per distance" in results
     ap = pd.read_csv(sweep_dir / "sweep.csv").query("camera == 'cam05' and condition == 'night' and distance_m == 50")
     shown = table.query("camera == 'cam05' and condition == 'night'").iloc[0]["AP 50 m"]
     assert float(shown) == pytest.approx(ap.ap.iloc[0], abs=5e-4)
@@ -126,3 +134,33 @@ def test_load_results_of_a_run_folder(sweep_dir):
     assert list(runs) == [("cam05", "night")]
     assert json.loads((sweep_dir / "runs" / "cam05-night" / "od50.json").read_text())["key"]["n_resamples"] == BOOTSTRAP_RESAMPLES  # one default everywhere
     assert meta["n_resamples"] == BOOTSTRAP_RESAMPLES  # printed with the result (the page's facts)
+
+
+def test_miss_rate_and_false_positives_per_distance(sweep_dir, page):
+    """Runs written before results.json held them: computed from their detections."""
+    from benchmark.scoring import working_point
+
+    section = page.split("<h2>Miss rate and false positives</h2>", 1)[1]
+    table = _html_table(section)
+    run = sweep_dir / "runs" / "cam01-day"
+    expected = working_point(json.loads((run / "groundtruth.json").read_text()), json.loads((run / "detections.json").read_text()))
+    shown = table.query("camera == 'cam01' and condition == 'day'").iloc[0]
+    assert shown["25 m"] == f"{expected[25.0]['miss_rate']:.2f} / {expected[25.0]['false_positives_per_image']:.2f}"
+    assert list(table.columns) == ["camera", "condition", "25 m", "50 m", "75 m", "100 m", "150 m", "200 m"]
+
+
+def test_no_line_is_fitted_through_too_few_environments():
+    from benchmark.experiments import spm
+    from benchmark.scoring import MIN_ENVIRONMENTS
+
+    def fitted_lines(n_environments):
+        table = pd.DataFrame({"camera": ["a", "b", "c"], "condition": ["day"] * 3, "mtf50_cy_per_mm": [80.0, 120.0, 160.0],
+                              "od50_m": [90.0, 120.0, 150.0], "sd_m": [5.0] * 3, "n_environments": [n_environments] * 3})
+        fig = spm.od50_vs_mtf50(table)
+        lines = [ln for ln in fig.axes[0].get_lines() if ln.get_linestyle() == "-" and len(ln.get_xdata()) == 2]
+        legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        return len(lines), legend
+
+    assert fitted_lines(MIN_ENVIRONMENTS)[0] == 1
+    n, legend = fitted_lines(MIN_ENVIRONMENTS - 1)
+    assert n == 0 and legend == ["day: no fit (3 from too few environments: not fitted)"]

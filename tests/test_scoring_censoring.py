@@ -108,7 +108,8 @@ def test_sweep_od50_csv_has_censored_column(tmp_path, monkeypatch):
 
     make_fake_sweep(tmp_path / "sw", monkeypatch)
     raw = pd.read_csv(tmp_path / "sw" / "od50.csv", keep_default_na=False)
-    assert list(raw.columns) == sweep_module.OD50_COLUMNS and list(raw.columns)[-1] == "censored"
+    assert list(raw.columns) == sweep_module.OD50_COLUMNS  # (columns added later go last: older readers keep theirs)
+    assert list(raw.columns)[-5:] == ["censored", "ap_range_m", "ap_range_sd_m", "ap_range_ci95_lo_m", "ap_range_ci95_hi_m"]
     assert set(raw["censored"]) <= {"", ">", "<"}
     assert "od50_m" in raw.columns  # kept for backwards compatibility
     table, od = sweep_module.load_sweep(tmp_path / "sw")
@@ -124,20 +125,38 @@ def _sub(name, per_distance_ap, od50_m, night=None):
 
 
 def test_leaderboard_rank_rule():
-    from benchmark.leaderboard.render import _fmt_od50, od50_sort_value, ranked
+    """Censored OD50s rank in their tier (above or below every measured one) by the AP range, the
+    area under AP vs distance: never by AP at one distance, never by the extrapolated number."""
+    from benchmark.leaderboard.render import _fmt_ap_range, _fmt_od50, od50_sort_value, ranked
 
-    far_hi = _sub("far-hi", [0.9, 0.9, 0.9, 0.9, 0.8, 0.7], 500.0)     # > 200, AP(200) 0.7
-    far_lo = _sub("far-lo", [0.9, 0.9, 0.9, 0.9, 0.7, 0.55], 1626.0)   # > 200, AP(200) 0.55, bigger extrapolation
-    far_inf = _sub("far-inf", [0.6, 0.6, 0.6, 0.6, 0.6, 0.6], None)    # > 200 (null: never falls)
+    far_hi = _sub("far-hi", [0.9, 0.9, 0.9, 0.9, 0.8, 0.7], 500.0)     # > 200, AP range 170 m
+    far_lo = _sub("far-lo", [0.9, 0.9, 0.9, 0.9, 0.7, 0.55], 1626.0)   # > 200, 161.25 m, bigger extrapolation
+    far_inf = _sub("far-inf", [0.6, 0.6, 0.6, 0.6, 0.6, 0.6], None)    # > 200 (null: never falls), 120 m; AP(200) 0.6 > 0.55
     measured = _sub("measured", [0.9, 0.9, 0.9, 0.8, 0.6, 0.4], 187.5)
-    near_hi = _sub("near-hi", [0.45, 0.3, 0.1, 0.0, 0.0, 0.0], 0.0)    # < 25, AP(25) 0.45
-    near_lo = _sub("near-lo", [0.1, 0.3, 0.1, 0.0, 0.0, 0.0], 0.0)     # < 25, AP(25) 0.1
+    near_hi = _sub("near-hi", [0.45, 0.3, 0.1, 0.0, 0.0, 0.0], 0.0)    # < 25, 26.875 m
+    near_lo = _sub("near-lo", [0.1, 0.45, 0.45, 0.1, 0.0, 0.0], 0.0)   # < 25, 30 m: AP(25) lower, more AP beyond
     order = [s["name"] for s in ranked([near_lo, measured, far_lo, near_hi, far_inf, far_hi])]
-    assert order == ["far-hi", "far-inf", "far-lo", "measured", "near-hi", "near-lo"]
-    assert _fmt_od50(far_lo["conditions"]["day"]) == (repr(200.55), "> 200")
-    assert _fmt_od50(near_hi["conditions"]["day"])[1] == "< 25"
+    assert order == ["far-hi", "far-lo", "far-inf", "measured", "near-lo", "near-hi"]
+    assert _fmt_od50(far_lo["conditions"]["day"]) == (repr(200 + 161.25 / 361.25), "> 200")
+    assert _fmt_od50(near_hi["conditions"]["day"]) == (repr(25 * 26.875 / 51.875), "< 25")
     assert _fmt_od50(measured["conditions"]["day"]) == (repr(187.5), "187.5 ± 1.0")
+    assert _fmt_ap_range(far_hi["conditions"]["day"]) == (repr(170.0), "170.0")
     assert od50_sort_value(None) is None
+
+
+def test_leaderboard_breaks_no_tie_by_one_distance():
+    """Two "> 200" curves with the same AP range but different AP at 200 m tie on the rank value
+    (the night OD50 then decides); the AP at the farthest distance alone never orders them."""
+    from benchmark.leaderboard.render import od50_sort_value, ranked
+
+    first = _sub("a-first", [0.875, 0.875, 0.875, 0.875, 0.875, 0.5], None)  # AP range 165.625 m, AP(200) 0.5
+    second = _sub("b-second", [0.875, 0.875, 0.875, 0.875, 0.8125, 0.625], None)  # 165.625 m, AP(200) 0.625
+    assert od50_sort_value(first["conditions"]["day"]) == od50_sort_value(second["conditions"]["day"])
+    assert [s["name"] for s in ranked([second, first])] == ["a-first", "b-second"]  # tie: by name
+    night = {"od50_m": 60.0, "od50_sd_m": 1.0, "per_distance": [{"distance_m": float(d), "ap": a}
+                                                               for d, a in zip(D, [0.9, 0.6, 0.4, 0.1, 0.0, 0.0])]}
+    second["conditions"]["night"] = night
+    assert [s["name"] for s in ranked([first, second])] == ["b-second", "a-first"]  # the night OD50 decides
 
 
 def test_committed_leaderboard_shows_no_extrapolated_number():
@@ -159,3 +178,20 @@ def test_run_and_score_print_a_bound_not_an_extrapolation():
     assert od50_text(distances, (0.9, 0.85, 0.8, 0.7)) == "OD50 > 200 m"  # extrapolation would say ~480 m
     assert od50_text(distances, (0.4, 0.3, 0.2, 0.1)) == "OD50 < 25 m"
     assert od50_text(distances, (0.9, 0.7, 0.3, 0.1)) == "OD50 75.0 m"
+
+
+def test_leaderboard_marks_figures_from_too_few_environments_and_shows_ap_range():
+    from benchmark.leaderboard.protocols import load_protocols
+    from benchmark.leaderboard.render import _fmt_ap_range, _fmt_od50, _few, columns
+    from benchmark.scoring import MIN_ENVIRONMENTS
+
+    measured = _sub("measured", [0.9, 0.9, 0.9, 0.8, 0.6, 0.4], 187.5)["conditions"]["day"]
+    censored = _sub("far", [0.6] * 6, None)["conditions"]["day"]
+    for cond, od50_text, range_text in ((measured, "187.5 ± 1.0", "148.8"), (censored, "> 200", "120.0")):
+        cond["n_environments"] = MIN_ENVIRONMENTS
+        assert (_fmt_od50(cond)[1], _fmt_ap_range(cond)[1]) == (od50_text, range_text)
+        cond["n_environments"] = MIN_ENVIRONMENTS - 1
+        assert (_fmt_od50(cond)[1], _fmt_ap_range(cond)[1]) == (od50_text + "†", range_text + "†")
+    assert _few([{"conditions": {"day": measured}}]) and _fmt_ap_range(None) == ("", "–")
+    keys = [c.key for c in columns(load_protocols()["metric-300"])]
+    assert keys[3:9] == ["day_od50", "dusk_od50", "night_od50", "night_regulation_od50", "day_ap_range", "night_ap_range"]

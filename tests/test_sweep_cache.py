@@ -230,6 +230,20 @@ def test_od50_table_matches_bootstrap(tmp_path, monkeypatch):
     assert row.sd_m == pytest.approx(oracle.sd_m)
     assert (row.ci95_lo_m, row.ci95_hi_m) == pytest.approx(oracle.ci95_m)
     assert row.n_resamples == 40 and row.n_environments == N_ENV
+    assert (row.ap_range_m, row.ap_range_sd_m) == pytest.approx((oracle.ap_range_m, oracle.ap_range_sd_m))
+    assert (row.ap_range_ci95_lo_m, row.ap_range_ci95_hi_m) == pytest.approx(oracle.ap_range_ci95_m)
+
+
+def test_od50_cache_without_ap_range_is_computed_again(tmp_path, monkeypatch):
+    """An od50.json written before the AP range (same key) is not reused: its AP range is missing
+    and its intervals predate the point-inside rule."""
+    make_fake_sweep(tmp_path / "sw", monkeypatch, n_resamples=40)
+    run = tmp_path / "sw" / "runs" / "cam01-day"
+    stored = json.loads((run / "od50.json").read_text())
+    old = {**stored, "od50": {k: v for k, v in stored["od50"].items() if not k.startswith("ap_range")}}
+    (run / "od50.json").write_text(json.dumps(old, indent=1))
+    boot = sweep_module.run_od50(run, n_resamples=40, seed=0)
+    assert boot.ap_range_m is not None and json.loads((run / "od50.json").read_text()) == stored
 
 
 def test_second_sweep_reuses_every_run(tmp_path, monkeypatch):

@@ -30,7 +30,8 @@ def test_sweep_then_report(fakes):
     assert "OD50 ± SD" in result.output and "cam12" in result.output and "150.0 (published_group)" in result.output
     od50 = pd.read_csv(out / "od50.csv")
     row = od50.query("camera == 'cam01' and condition == 'night'").iloc[0]
-    assert f"{row.od50_m:.1f} ± {row.sd_m:.1f}" in result.output
+    assert f"{row.od50_m:.1f} ± {row.sd_m:.1f}†" in result.output  # 4 environments: marked, and the mark explained
+    assert f"{row.ap_range_m:.1f} ± {row.ap_range_sd_m:.1f}†" in result.output and "† from fewer than" in result.output
     again = CliRunner().invoke(app, args)  # cached: same table
     assert again.exit_code == 0 and f"{row.od50_m:.1f} ± {row.sd_m:.1f}" in again.output
     page = CliRunner().invoke(app, ["report", str(out)])

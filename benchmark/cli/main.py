@@ -17,6 +17,7 @@ from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
+from benchmark.scoring.detectability import FOUND_IOU, FOUND_SCORE
 from benchmark.suggest import did_you_mean
 from metricscenes.cli_support import SCHEDULER_HELP, cannot_write, fail, progress_bar
 
@@ -126,11 +127,12 @@ def run(
     title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
-    table = Table(title=title)
-    for col_name in ("distance (m)", "AP", "AP50", "images"):
+    table = Table(title=title, caption=WORKING_POINT_CAPTION)
+    for col_name in ("distance (m)", "AP", "AP50", "images", "miss rate", "FP/image"):
         table.add_column(col_name, justify="right")
     for row in results.per_distance:
-        table.add_row(f"{row.distance_m:g}", f"{row.ap:.3f}", f"{row.ap50:.3f}", str(row.n_images))
+        table.add_row(f"{row.distance_m:g}", f"{row.ap:.3f}", f"{row.ap50:.3f}", str(row.n_images),
+                      _rate(row.miss_rate), _rate(row.false_positives_per_image))
     console.print(table)
     console.print(od50_text(*results.ap_curve()))
     if camera_text(results.camera.model_dump()):
@@ -244,13 +246,23 @@ def sweep(
     table.add_column("cy/mrad (f)", justify="right", no_wrap=True)
     for condition in conds:
         table.add_column(condition, justify="right")
+    ranges = Table(title="AP range ± SD (m): area under AP vs distance, defined where OD50 is censored (docs/scoring.md)")
+    ranges.add_column("camera")
+    for condition in conds:
+        ranges.add_column(condition, justify="right")
     for camera_name, rows in od50_table.groupby("camera", sort=False):
         by_condition = rows.set_index("condition")
         cells = [sweep_module.od50_cell(by_condition.loc[condition]) for condition in conds]
         mtf, mrad = rows["mtf50_cy_per_mm"].iloc[0], rows["mtf50_cy_per_mrad"].iloc[0]
         table.add_row(camera_name, f"{mtf:.1f} ({rows['mtf50_source'].iloc[0]})",
                       f"{mrad:.3f} ({rows['focal_length_mm'].iloc[0]:g})", *cells)
+        ranges.add_row(camera_name, *(sweep_module.ap_range_cell(by_condition.loc[condition]) for condition in conds))
     console.print(table)
+    console.print(ranges)
+    from benchmark.scoring import few_footnote, too_few
+
+    if any(map(too_few, od50_table["n_environments"])):
+        console.print(few_footnote(), highlight=False)
     if getattr(col, "subset", None):
         console.print(subset_text(col.subset))
     console.print(f"wrote {out / 'sweep.csv'}, {out / 'od50.csv'}")
@@ -292,8 +304,8 @@ def report(
 def score(
     results_dir: Annotated[Path, typer.Argument(help="a `benchmark run` folder")],
     backend: Annotated[str, typer.Option(help="faster-coco-eval | pycocotools")] = "faster-coco-eval",
-    score_threshold: Annotated[float, typer.Option(min=0.0, max=1.0, help="working threshold for detection rates")] = 0.25,
-    iou: Annotated[float, typer.Option(min=0.0, max=1.0, help="IoU that counts as finding the car")] = 0.5,
+    score_threshold: Annotated[float, typer.Option(min=0.0, max=1.0, help="working threshold for detection rates")] = FOUND_SCORE,
+    iou: Annotated[float, typer.Option(min=0.0, max=1.0, help="IoU that counts as finding the car")] = FOUND_IOU,
     as_json: Annotated[bool, typer.Option("--json")] = False,
 ) -> None:
     """Re-score a run from its detections: AP per distance, detection rates, what the car was taken for."""
@@ -310,7 +322,8 @@ def score(
     except (json.JSONDecodeError, ValueError, KeyError) as exc:
         fail(f"{results_dir}: cannot score ({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})")
     rates = detection_rates(groundtruth, detections, score_threshold=score_threshold, iou_threshold=iou)
-    rows = [{**a, **{k: r[k] for k in ("rate", "detected", "mistaken_for", "missed_scenes")}}
+    rows = [{**a, **{k: r[k] for k in ("rate", "detected", "miss_rate", "false_positives_per_image", "mistaken_for",
+                                        "missed_scenes")}}
             for a, r in zip(ap_rows, rates, strict=True)]
     distance_od50 = od50([r["distance_m"] for r in rows], [r["ap"] for r in rows])
     if as_json:
@@ -319,14 +332,23 @@ def score(
                           "per_distance": rows}, indent=1))
         return
     table = Table(title=f"{results_dir} · {backend}")
-    for col in ("distance (m)", "AP", "AP50", f"found (score ≥ {score_threshold:g})", "taken for"):
+    for col in ("distance (m)", "AP", "AP50", f"found (score ≥ {score_threshold:g})", "miss rate", "FP/image", "taken for"):
         table.add_column(col, justify="right")
     for r in rows:
         taken = ", ".join(f"{k} {v}" for k, v in r["mistaken_for"].items())
         table.add_row(f"{r['distance_m']:g}", f"{r['ap']:.3f}", f"{r['ap50']:.3f}",
-                      f"{r['detected']}/{r['n_images']}", taken)
+                      f"{r['detected']}/{r['n_images']}", _rate(r["miss_rate"]), _rate(r["false_positives_per_image"]), taken)
     console.print(table)
     console.print(od50_text([r["distance_m"] for r in rows], [r["ap"] for r in rows]))
+
+
+WORKING_POINT_CAPTION = (f"miss rate and FP/image at the working threshold: a car detection of score ≥ {FOUND_SCORE:g} "
+                         f"on the car at IoU ≥ {FOUND_IOU:g} finds it; FP/image: car detections at that score that do "
+                         "not (docs/scoring.md)")
+
+
+def _rate(value: float | None) -> str:
+    return "–" if value is None else f"{value:.2f}"
 
 
 def od50_text(distances_m: list[float], ap: list[float]) -> str:

@@ -16,8 +16,16 @@ COCO's per-image matches (:func:`benchmark.scoring.bootstrap.weighted_ap`). Inte
 95 % percentile intervals; ± is the bootstrap SD.
 
 **Censoring.** When A's or B's OD50 is censored (AP does not cross 0.5 inside the measured
-distances: "> 200 m" or "< 25 m"), ΔOD50 in metres is not measured: the verdict says so and
-the ΔAP per distance carries the comparison.
+distances: "> 200 m" or "< 25 m"), ΔOD50 in metres is not measured: the verdict rests on the
+ΔAP range (area under AP vs distance, :func:`benchmark.scoring.ap_range`, in metres, from the
+same paired resamples), called where its interval excludes 0 and the camera with the larger AP
+range found enough cars at a distance where its AP is higher (below).
+
+**Minimum sample.** Below :data:`benchmark.scoring.MIN_ENVIRONMENTS` environments per distance
+no difference is called: the verdict is the one line "sample too small: ..." and the table
+is still printed. Every interval encloses its point (:func:`benchmark.scoring.enclose`).
+Per distance each side's miss rate and false positives per image at the working threshold
+are reported beside the ΔAP (docs/scoring.md).
 
 **Enough cars behind an AP.** AP is computed from every detection down to score 0.001, so a
 camera that sees nothing still gets an AP from a few low-score boxes (0.09 from one box of
@@ -27,7 +35,7 @@ score 0.02). A difference at a distance is *called* only when its 95 % interval 
 :data:`FOUND_SCORE` overlapping the car's box at IoU ≥ :data:`FOUND_IOU`
 (:func:`benchmark.scoring.detection_rates`, ``benchmark score``'s working point). Where
 neither camera finds that many, both are *blind* there, and the verdict says so ("both
-blind at night beyond 25 m") instead of calling a difference (docs/detection.md).
+blind at night beyond 25 m") instead of calling a difference (docs/scoring.md).
 """
 
 from __future__ import annotations
@@ -43,7 +51,10 @@ import numpy as np
 import typer
 
 from benchmark.result_files import ResultsFileError, RunFolder, read_results, read_sweep_record
-from benchmark.scoring import ap_by_distance, detection_rates, format_od50, od50, od50_censoring
+from benchmark.scoring import (
+    FOUND_IOU, FOUND_SCORE, MIN_ENVIRONMENTS, ap_by_distance, ap_range, detection_rates, enclose, format_od50, od50,
+    od50_censoring, sample_too_small_text, too_few,
+)
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
 from benchmark.suggest import did_you_mean
 
@@ -52,11 +63,8 @@ CONDITION_WORDS = {"day": "by day", "night": "at night", "dusk": "at dusk"}
 MIN_FOUND_CARS = 3
 """Fewest cars the camera with the higher AP must have found at a distance for a difference there to be called."""
 MIN_FOUND_FRACTION = 0.2
-"""... and at least this fraction of the cars at that distance (10 of 50 on metric-300, 3 of 10 on quick)."""
-FOUND_SCORE = 0.25
-"""A car is found by a car detection of at least this score (``benchmark score``'s working threshold) ..."""
-FOUND_IOU = 0.5
-"""... overlapping its ground-truth box at least this much."""
+"""... and at least this fraction of the cars at that distance (10 of 50 on metric-300, 3 of 10 on quick).
+A car is found at the working threshold, :data:`benchmark.scoring.FOUND_SCORE` and ``FOUND_IOU``."""
 
 
 def cars_needed(n_cars: int) -> int:
@@ -74,8 +82,13 @@ def blind_below(n_cars: int) -> int:
 
 def found_cars(side: "Side") -> dict[float, tuple[int, int]]:
     """Per distance: (cars found, cars) of one run (:data:`FOUND_SCORE`, :data:`FOUND_IOU`)."""
+    return {d: (r["detected"], r["n_images"]) for d, r in working_rows(side).items()}
+
+
+def working_rows(side: "Side") -> dict[float, dict]:
+    """Per distance: :func:`benchmark.scoring.detection_rates` of one run at the working threshold."""
     rows = detection_rates(side.groundtruth, side.detections, score_threshold=FOUND_SCORE, iou_threshold=FOUND_IOU)
-    return {float(r["distance_m"]): (int(r["detected"]), int(r["n_images"])) for r in rows}
+    return {float(r["distance_m"]): r for r in rows}
 
 
 class CompareError(ValueError):
@@ -100,6 +113,14 @@ class Side(RunFolder):
     @property
     def scenes(self) -> set:
         return {(im["environment_id"], float(im["distance_m"])) for im in self.groundtruth["images"]}
+
+    @property
+    def environments_per_distance(self) -> int:
+        """The fewest environments at any one distance (what the minimum sample is counted in)."""
+        per: dict[float, set] = {}
+        for env, distance in self.scenes:
+            per.setdefault(distance, set()).add(env)
+        return min((len(v) for v in per.values()), default=0)
 
 
 def resolve_run(path: str | Path, camera: str | None = None, condition: str = "day") -> Path:
@@ -170,11 +191,13 @@ def compare_runs(
     paired: bool = True,
     category_id: int = 3,
 ) -> dict:
-    """Paired bootstrap of ΔAP per distance and ΔOD50 (A − B); see the module docstring.
+    """Paired bootstrap of ΔAP per distance, ΔOD50 and ΔAP range (A − B); see the module docstring.
 
-    Returns a JSON-able dict: labels, per-distance AP of each and ΔAP with SD and interval,
-    OD50 of each (with censoring), ΔOD50 with SD and interval (None when censored), the
-    verdict line, and the bootstrap settings.
+    Returns a JSON-able dict: labels, per-distance AP of each and ΔAP with SD and interval (and
+    each side's cars found, miss rate and false positives per image), OD50 and AP range of each
+    (with censoring), ΔOD50 with SD and interval (None when censored), ΔAP range with SD,
+    interval and whether it is called, the minimum sample, the verdict line, and the bootstrap
+    settings.
     """
     check_comparable(a, b)
     if n_resamples < 2:
@@ -191,13 +214,14 @@ def compare_runs(
         ap = [r["ap"] for r in rows]
         censored, bound = od50_censoring(dist, ap)
         sides[key] = {"rows": rows, "distances": dist, "ap": np.asarray(ap, dtype=float), "od50_m": od50(dist, ap),
-                      "censored": censored, "bound_m": bound,
+                      "ap_range_m": ap_range(dist, ap), "censored": censored, "bound_m": bound,
                       "tables": _match_tables(side.groundtruth, side.detections, category_id, env_index)}
     distances = sides["a"]["distances"]
     rng = np.random.default_rng(seed)
     n = len(envs)
     d_ap = np.empty((n_resamples, len(distances)))
     d_od = np.empty(n_resamples)
+    d_range = np.empty(n_resamples)
     for k in range(n_resamples):
         draw_a = rng.integers(0, n, n)
         draw_b = draw_a if paired else rng.integers(0, n, n)
@@ -208,38 +232,53 @@ def compare_runs(
         d_ap[k] = ap_ab[0] - ap_ab[1]
         with np.errstate(invalid="ignore"):
             d_od[k] = od50(distances, ap_ab[0]) - od50(distances, ap_ab[1])
+        d_range[k] = ap_range(distances, ap_ab[0]) - ap_range(distances, ap_ab[1])
+    per_env = min(a.environments_per_distance, b.environments_per_distance)
+    too_small = too_few(per_env)  # no call at all: the rows say what the interval alone would be
     per_distance = []
-    found = {"a": found_cars(a), "b": found_cars(b)}
+    working = {"a": working_rows(a), "b": working_rows(b)}
+    empty = {"detected": 0, "n_images": 0, "miss_rate": None, "false_positives_per_image": None}
     for j, dm in enumerate(distances):
         col = d_ap[:, j][np.isfinite(d_ap[:, j])]
-        lo, hi = percentile_interval(col, confidence_level)
         delta = float(sides["a"]["ap"][j] - sides["b"]["ap"][j])
-        (found_a, n_cars), (found_b, _) = found["a"].get(float(dm), (0, 0)), found["b"].get(float(dm), (0, 0))
+        lo, hi = enclose(delta, *percentile_interval(col, confidence_level))
+        wa, wb = working["a"].get(float(dm), empty), working["b"].get(float(dm), empty)
+        found_a, n_cars, found_b = int(wa["detected"]), int(wa["n_images"]), int(wb["detected"])
         needed = cars_needed(n_cars)
         backed = (found_a if delta > 0 else found_b) >= needed  # the higher AP rests on found cars
         per_distance.append({"distance_m": float(dm), "ap_a": float(sides["a"]["ap"][j]), "ap_b": float(sides["b"]["ap"][j]),
                              "delta_ap": delta, "sd": float(np.std(col, ddof=1)) if col.size > 1 else None,
                              "ci95": [lo, hi], "n_cars": n_cars, "found_a": found_a, "found_b": found_b,
                              "cars_needed": needed, "blind_below": blind_below(n_cars),
-                             "resolved": bool((lo > 0 or hi < 0) and backed),
-                             "blind": bool(max(found_a, found_b) < blind_below(n_cars))})
+                             "resolved": bool((lo > 0 or hi < 0) and backed and not too_small),
+                             "blind": bool(max(found_a, found_b) < blind_below(n_cars)),
+                             "miss_rate_a": wa["miss_rate"], "miss_rate_b": wb["miss_rate"],
+                             "fp_per_image_a": wa["false_positives_per_image"],
+                             "fp_per_image_b": wb["false_positives_per_image"]})
     censored = bool(sides["a"]["censored"] or sides["b"]["censored"])
     finite = d_od[np.isfinite(d_od)]
     delta_od = float(sides["a"]["od50_m"] - sides["b"]["od50_m"])
     if censored:
         od_block = {"delta_m": None, "sd_m": None, "ci95_m": [None, None]}
     else:
-        lo, hi = percentile_interval(d_od[~np.isnan(d_od)], confidence_level)
+        lo, hi = enclose(delta_od, *percentile_interval(d_od[~np.isnan(d_od)], confidence_level))
         od_block = {"delta_m": delta_od, "sd_m": float(np.std(finite, ddof=1)) if finite.size > 1 else None,
                     "ci95_m": [lo, hi]}
+    range_block = _range_block(float(sides["a"]["ap_range_m"] - sides["b"]["ap_range_m"]), d_range, per_distance,
+                               confidence_level, too_small)
     out = {
         "format": COMPARE_FORMAT,
         "a": {"label": _label(a, b), "folder": str(a.folder), "camera": a.camera, "condition": a.condition,
-              "od50_m": _finite(sides["a"]["od50_m"]), "censored": sides["a"]["censored"], "bound_m": sides["a"]["bound_m"]},
+              "od50_m": _finite(sides["a"]["od50_m"]), "censored": sides["a"]["censored"], "bound_m": sides["a"]["bound_m"],
+              "ap_range_m": sides["a"]["ap_range_m"]},
         "b": {"label": _label(b, a), "folder": str(b.folder), "camera": b.camera, "condition": b.condition,
-              "od50_m": _finite(sides["b"]["od50_m"]), "censored": sides["b"]["censored"], "bound_m": sides["b"]["bound_m"]},
+              "od50_m": _finite(sides["b"]["od50_m"]), "censored": sides["b"]["censored"], "bound_m": sides["b"]["bound_m"],
+              "ap_range_m": sides["b"]["ap_range_m"]},
         "collection_manifest_sha256": a.manifest_sha256,
         "n_environments": n,
+        "environments_per_distance": per_env,
+        "min_environments": MIN_ENVIRONMENTS,
+        "sample_too_small": too_small,
         "n_resamples": int(n_resamples),
         "seed": int(seed),
         "confidence_level": confidence_level,
@@ -248,13 +287,31 @@ def compare_runs(
                        "iou": FOUND_IOU},
         "per_distance": per_distance,
         "delta_od50": od_block,
+        "delta_ap_range": range_block,
     }
     out["verdict"] = verdict(out)
     return out
 
 
+def _range_block(delta: float, resampled: np.ndarray, per_distance: list[dict], confidence_level: float,
+                 too_small: bool) -> dict:
+    """ΔAP range (m) with its SD and enclosing interval; ``resolved`` where the interval excludes 0
+    and the camera with the larger AP range found enough cars (:func:`cars_needed`) at a distance
+    where its AP is the higher: an area built from low-score boxes alone is not called."""
+    lo, hi = enclose(delta, *percentile_interval(resampled, confidence_level))
+    side = "a" if delta > 0 else "b"
+    sign = 1.0 if delta > 0 else -1.0
+    backed = any(sign * r["delta_ap"] > 0 and r[f"found_{side}"] >= r["cars_needed"] for r in per_distance)
+    return {"delta_m": delta, "sd_m": float(np.std(resampled, ddof=1)) if resampled.size > 1 else None,
+            "ci95_m": [lo, hi], "resolved": bool((lo > 0 or hi < 0) and backed and not too_small)}
+
+
 def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
+
+
+def _rate(x: float | None) -> str:
+    return "–" if x is None else f"{x:.2f}"
 
 
 def _when(cond_a: str, cond_b: str) -> tuple[str, str]:
@@ -321,6 +378,8 @@ def _unbacked_text(result: dict) -> str:
 def verdict(result: dict) -> str:
     """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)",
     "... AP differs at 50 m ...", or "both blind at night beyond 25 m" (see the module docstring)."""
+    if result.get("sample_too_small"):
+        return sample_too_small_text(result["environments_per_distance"])
     a, b = result["a"], result["b"]
     when, _ = _when(a["condition"], b["condition"])
     when = f" {when}" if when else ""
@@ -355,6 +414,8 @@ def _od50_verdict(result: dict) -> str:
         where = ", ".join(format(r["distance_m"], "g") for r in resolved)
         tail = (f"AP differs at {where} m"
                 if resolved else "no AP difference resolved at any distance")
+        if result.get("delta_ap_range") is not None:
+            return _range_verdict(result, od_a, od_b, when + suffix, tail, pct)
         for first, second in ((a, b), (b, a)):  # a lower bound beats a measured value below it
             if first["censored"] == ">" and not second["censored"] and second["od50_m"] is not None:
                 gap = first["bound_m"] - second["od50_m"]
@@ -372,6 +433,21 @@ def _od50_verdict(result: dict) -> str:
         lo, hi = -hi, -lo
     return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{when}{suffix} "
             f"({pct}: {lo:.0f}–{hi:.0f} m)")
+
+
+def _range_verdict(result: dict, od_a: str, od_b: str, when: str, tail: str, pct: str) -> str:
+    """The verdict where ΔOD50 is censored: on the ΔAP range (docs/scoring.md, "AP range")."""
+    a, b, rng = result["a"], result["b"], result["delta_ap_range"]
+    d, sd, (lo, hi) = rng["delta_m"], rng["sd_m"] or 0.0, rng["ci95_m"]
+    bounds = f"OD50 {od_a} vs {od_b}: outside the measured distances, ΔOD50 is not measured"
+    if not rng["resolved"]:
+        return (f"no difference resolved between {a['label']} and {b['label']}{when}: ΔAP range = {d:+.0f} ± {sd:.0f} m "
+                f"({pct}: {lo:.0f} to {hi:.0f} m; {bounds}); {tail}")
+    first, second = (a, b) if d > 0 else (b, a)
+    if d < 0:
+        lo, hi = -hi, -lo
+    return (f"{first['label']} detects cars farther than {second['label']}{when}: AP range {first['ap_range_m']:.0f} vs "
+            f"{second['ap_range_m']:.0f} m, {abs(d):.0f} ± {sd:.0f} m more ({pct}: {lo:.0f}–{hi:.0f} m; {bounds}); {tail}")
 
 
 def plot_compare(result: dict, out: str | Path) -> Path:
@@ -452,20 +528,29 @@ def register(app) -> None:
         table = Table(title=f"{ra['label']} − {rb['label']} · paired bootstrap, {result['n_resamples']} resamples "
                             f"over {result['n_environments']} environments")
         for name in ("distance (m)", f"AP {ra['label']}", f"AP {rb['label']}", "ΔAP ± SD", "95 %",
-                     f"cars found {ra['label']}", f"cars found {rb['label']}", "called"):
+                     f"cars found {ra['label']}", f"cars found {rb['label']}", f"FP/image {ra['label']}",
+                     f"FP/image {rb['label']}", "called"):
             table.add_column(name, justify="right")
         for r in result["per_distance"]:
             called = "yes" if r["resolved"] else ("blind" if r["blind"] else "no")
             table.add_row(f"{r['distance_m']:g}", f"{r['ap_a']:.3f}", f"{r['ap_b']:.3f}",
                           f"{r['delta_ap']:+.3f} ± {r['sd'] or 0:.3f}", f"{r['ci95'][0]:+.3f} to {r['ci95'][1]:+.3f}",
-                          f"{r['found_a']}/{r['n_cars']}", f"{r['found_b']}/{r['n_cars']}", called)
+                          f"{r['found_a']}/{r['n_cars']}", f"{r['found_b']}/{r['n_cars']}",
+                          _rate(r["fp_per_image_a"]), _rate(r["fp_per_image_b"]), called)
         console.print(table)
+        rng, od = result["delta_ap_range"], result["delta_od50"]
+        delta_od = ("" if od["delta_m"] is None else f", Δ {od['delta_m']:+.1f} ± {od['sd_m'] or 0:.1f} m "
+                    f"(95 %: {od['ci95_m'][0]:.1f} to {od['ci95_m'][1]:.1f} m)")
         console.print(f"OD50: {ra['label']} {format_od50(ra['od50_m'], ra['censored'], ra['bound_m'])}, "
-                      f"{rb['label']} {format_od50(rb['od50_m'], rb['censored'], rb['bound_m'])}", highlight=False)
-        console.print(f"cars found: a car detection of score >= {FOUND_SCORE:g} on the car at IoU >= {FOUND_IOU:g}; "
-                      f"a difference is called where the 95 % interval excludes 0 and the higher AP rests on at least "
-                      f"{MIN_FOUND_CARS} found cars ({MIN_FOUND_FRACTION:.0%} of them where more); 'blind': neither camera "
-                      "found that many (docs/detection.md)", highlight=False)
+                      f"{rb['label']} {format_od50(rb['od50_m'], rb['censored'], rb['bound_m'])}{delta_od}; AP range: "
+                      f"{ra['label']} {ra['ap_range_m']:.1f} m, {rb['label']} {rb['ap_range_m']:.1f} m, "
+                      f"Δ {rng['delta_m']:+.1f} ± {rng['sd_m'] or 0:.1f} m (95 %: {rng['ci95_m'][0]:.1f} to "
+                      f"{rng['ci95_m'][1]:.1f} m)", highlight=False)
+        console.print(f"cars found (1 − miss rate) and FP/image (car boxes that do not find the car, per image): at "
+                      f"score >= {FOUND_SCORE:g}, IoU >= {FOUND_IOU:g}; a difference is called where the 95 % interval "
+                      f"excludes 0, the higher AP rests on at least {MIN_FOUND_CARS} found cars ({MIN_FOUND_FRACTION:.0%} "
+                      f"of them where more) and there are at least {MIN_ENVIRONMENTS} environments per distance; "
+                      "'blind': neither camera found that many (docs/scoring.md)", highlight=False)
         console.print(result["verdict"], highlight=False)
         if out is not None:
             out.mkdir(parents=True, exist_ok=True)

@@ -5,7 +5,8 @@ collection and one detector, e.g. ``benchmark report results/mine-day results/qu
 one page. It holds AP-vs-distance curves per condition (one line per camera), the System
 Performance Maps and OD50 vs MTF50 (:mod:`benchmark.experiments.spm`; two or more MTF50
 values only), a table (camera, MTF50 in cycles/mm on the sensor and cycles/mrad in object
-space, focal length and field of view, condition, OD50 ± SD, AP per distance), and per
+space, focal length and field of view, condition, OD50 ± SD, AP range ± SD, AP per distance),
+the miss rate and false positives per image at the working threshold per distance, and per
 distance a strip of camera images, cropped around the car at the
 same field of view for every camera, with the ground-truth box (green) and the best
 car detection (red, with its score). Every image is embedded as base64 PNG and the
@@ -15,6 +16,11 @@ to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
 Where the cameras differ in focal length the MTF50 axis of the figures is the angular one
 (cycles/mrad in object space, :func:`benchmark.experiments.spm.mtf50_axis`); the captions say
 which axis each figure uses.
+
+**Minimum sample.** OD50 and AP range from fewer than :data:`benchmark.scoring.MIN_ENVIRONMENTS`
+environments per distance are marked :data:`benchmark.scoring.FEW_MARK` (a footnote says why),
+the page says "sample too small: ..." above the table instead of inviting a comparison, and
+the OD50-vs-MTF50 figure fits no line through them (docs/scoring.md).
 """
 
 from __future__ import annotations
@@ -44,6 +50,7 @@ from benchmark.experiments.sweep import (  # noqa: E402
     run_od50,
     with_censoring,
 )
+from benchmark.scoring import FEW_MARK, ap_range, few_footnote, mark_few, sample_too_small_text, too_few, working_point  # noqa: E402
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES  # noqa: E402
 from benchmark.scoring.od50 import format_od50  # noqa: E402
 from metricscenes.manifest import parse_illuminance_condition  # noqa: E402
@@ -81,12 +88,16 @@ def load_results(results_dir) -> tuple[pd.DataFrame, pd.DataFrame, dict[tuple[st
              "mtf50_cy_per_mm": mtf50, "mtf50_source": source, "condition": results.condition}
     table = pd.DataFrame([{**ident, "distance_m": r.distance_m, "ap": r.ap, "ap50": r.ap50, "n_images": r.n_images}
                           for r in results.per_distance], columns=TABLE_COLUMNS)
+    n_env = min((r.n_images for r in results.per_distance), default=0)  # one image per environment and distance
     try:
         boot = run_od50(root, n_resamples=BOOTSTRAP_RESAMPLES, seed=results.seed)
         od50_m, sd_m, (lo, hi), n_resamples = boot.od50_m, boot.sd_m, boot.ci95_m, boot.n_resamples
+        ranges = (boot.ap_range_m, boot.ap_range_sd_m, *boot.ap_range_ci95_m)
     except ValueError:  # one environment: no bootstrap
         od50_m, sd_m, lo, hi, n_resamples = _num(results.od50_m), math.nan, math.nan, math.nan, None
-    od50 = pd.DataFrame([{**ident, "od50_m": od50_m, "sd_m": sd_m, "ci95_lo_m": lo, "ci95_hi_m": hi}])
+        ranges = (ap_range(*results.ap_curve()), math.nan, math.nan, math.nan)
+    od50 = pd.DataFrame([{**ident, "od50_m": od50_m, "sd_m": sd_m, "ci95_lo_m": lo, "ci95_hi_m": hi, "n_environments": n_env,
+                          **dict(zip(("ap_range_m", "ap_range_sd_m", "ap_range_ci95_lo_m", "ap_range_ci95_hi_m"), ranges))}])
     od50 = with_censoring(od50, table)
     meta = {"collection": results.collection.model_dump(exclude_unset=True),
             "detector": results.detector.model_dump(exclude_unset=True) if results.detector else {},
@@ -202,25 +213,57 @@ def plot_ap_curves(table: pd.DataFrame, out=None, *, axis: str = "sensor"):
 
 
 def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
-    """One row per camera × condition: MTF50, OD50 ± SD, 95 % interval, AP per distance.
+    """One row per camera × condition: MTF50, OD50 ± SD, 95 % interval, AP range ± SD and its
+    interval, AP per distance.
 
     A censored OD50 (``censored`` ">" or "<": AP does not cross 0.5 inside the measured
     distances) shows its bound, "> 200" or "< 25", with no ± and no interval: the number
-    behind it is an extrapolation."""
+    behind it is an extrapolation. OD50 and AP range from too few environments carry
+    :data:`benchmark.scoring.FEW_MARK` (:func:`benchmark.scoring.mark_few`)."""
     ap = table.pivot_table(index=["camera", "condition"], columns="distance_m", values="ap", sort=False)
     ap.columns = [f"AP {d:g} m" for d in ap.columns]
     rows = od50.set_index(["camera", "condition"])
+    n_env = _col(rows, "n_environments", None)
     out = pd.DataFrame({
         "MTF50 (cy/mm)": rows["mtf50_cy_per_mm"].map(lambda v: f"{v:.1f}" if np.isfinite(v) else "–"),
         "MTF50 (cy/mrad)": [_fmt(v, ".3f") for v in _col(rows, "mtf50_cy_per_mrad", np.nan)],
         "focal length (mm)": [_fmt(v, "g") for v in _col(rows, "focal_length_mm", np.nan)],
         "FOV (°)": _col(rows, "fov_deg", "–"),
-        "OD50 ± SD (m)": [_pm(o, s, c, b) for o, s, c, b in zip(rows["od50_m"], rows["sd_m"], _col(rows, "censored", ""),
-                                                                _col(rows, "bound_m", np.nan))],
+        "OD50 ± SD (m)": [mark_few(_pm(o, s, c, b), n) for o, s, c, b, n in zip(
+            rows["od50_m"], rows["sd_m"], _col(rows, "censored", ""), _col(rows, "bound_m", np.nan), n_env)],
         "95 % interval (m)": [_interval(lo, hi) if not c else "–" for lo, hi, c in zip(
             rows.get("ci95_lo_m", np.nan), rows.get("ci95_hi_m", np.nan), _col(rows, "censored", ""))],
+        "AP range ± SD (m)": [mark_few(_pm(_num(v), _num(s)), n) for v, s, n in zip(
+            _col(rows, "ap_range_m", np.nan), _col(rows, "ap_range_sd_m", np.nan), n_env)],
+        "AP range 95 % (m)": [_interval(_num(lo), _num(hi)) for lo, hi in zip(
+            _col(rows, "ap_range_ci95_lo_m", np.nan), _col(rows, "ap_range_ci95_hi_m", np.nan))],
     }, index=rows.index)
     return out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+
+
+def working_point_table(runs: dict[tuple[str, str], Path]) -> pd.DataFrame | None:
+    """Per camera × condition, per distance: "miss rate / false positives per image" at the working
+    threshold, from each run's results.json (computed from its detections where an older run lacks
+    them); None where no run has either."""
+    rows = []
+    for (camera, condition), folder in runs.items():
+        per = _working_point(Path(folder))
+        if per:
+            rows.append({"camera": camera, "condition": condition,
+                         **{f"{d:g} m": f"{m:.2f} / {fp:.2f}" for d, (m, fp) in sorted(per.items())}})
+    return pd.DataFrame(rows).fillna("–") if rows else None
+
+
+def _working_point(folder: Path) -> dict[float, tuple[float, float]] | None:
+    try:
+        rows = read_results(folder / "results.json").per_distance
+        if rows and all(r.miss_rate is not None and r.false_positives_per_image is not None for r in rows):
+            return {r.distance_m: (r.miss_rate, r.false_positives_per_image) for r in rows}
+        gt = json.loads((folder / "groundtruth.json").read_text())
+        dets = json.loads((folder / "detections.json").read_text())
+    except (OSError, ValueError):  # no run folder there (a sweep's table alone), or unreadable: not shown
+        return None
+    return {d: (r["miss_rate"], r["false_positives_per_image"]) for d, r in working_point(gt, dets).items()}
 
 
 def crop_with_boxes(image_path: Path, gt_box, det, *, width_px: int = THUMB_WIDTH_PX):
@@ -308,7 +351,21 @@ def report(results_dir, out=None) -> Path:
                         f"{_fig_base64(fig)}'><figcaption>{html.escape(caption)}</figcaption></figure>")
         plt.close(fig)
     summary = summary_table(table, od50)
-    sections.append("<h2>Results</h2>" + summary.to_html(index=False, classes="results", border=0, escape=True))
+    few = [n for n in _col(od50, "n_environments", None) if too_few(n)]
+    sections.append("<h2>Results</h2>"
+                    + (f"<p class='verdict'>{html.escape(sample_too_small_text(min(few)))}: the figures marked "
+                       f"{FEW_MARK} are shown, not compared, and no line is fitted through them.</p>" if few else "")
+                    + summary.to_html(index=False, classes="results", border=0, escape=True)
+                    + (f"<p class='note'>{html.escape(few_footnote())}. AP range: area under AP vs distance (m), defined "
+                       "where OD50 is censored.</p>" if few else
+                       "<p class='note'>AP range: area under AP vs distance (m), defined where OD50 is censored "
+                       "(docs/scoring.md).</p>"))
+    working = working_point_table(runs)
+    if working is not None:
+        sections.append("<h2>Miss rate and false positives</h2><p>At the working threshold, per distance: miss rate / "
+                        "false positives per image (a car detection of score ≥ 0.25 overlapping the car at IoU ≥ 0.5 "
+                        "finds it; the false positives are car detections at that score that do not; docs/scoring.md)."
+                        "</p>" + working.to_html(index=False, classes="results", border=0, escape=True))
     strips = image_strips({k: v for k, v in runs.items() if parse_illuminance_condition(k[1]) is None}, table)
     if strips:
         sections.append("<h2>Images</h2><p>First environment, cropped around the car at the same field of view for "
@@ -342,7 +399,8 @@ def _main_figures(table: pd.DataFrame, od50: pd.DataFrame, fig_dir: Path) -> lis
     if od50["camera"].nunique() >= 2 and od50[column].notna().all():
         measured = (float(table["distance_m"].min()), float(table["distance_m"].max()))
         figures.append(("OD50 vs MTF50", "OD50 with its 95 % bootstrap interval over environments; least-squares "
-                        "line per condition through the OD50s inside the measured distances, its slope in the "
+                        "line per condition through the OD50s inside the measured distances (none through OD50s from "
+                        "too few environments: the legend says so), its slope in the "
                         "legend; hollow triangles: OD50 beyond the measured distances, drawn at the bound (▲ \u2018> farthest\u2019: a "
                         f"lower bound; ▼ \u2018< nearest\u2019), not fitted. {why}.",
                         spm.od50_vs_mtf50(od50, fig_dir / "od50_vs_mtf50", measured_range_m=measured, axis=axis)))

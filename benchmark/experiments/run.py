@@ -642,16 +642,17 @@ class _CameraRun:
                 for detector, stage, detections in zip(self.detectors, self.stages, self.detections)][0]
 
     def _write(self, groundtruth: dict, detector, stage: Path, detections: list[dict]) -> RunResults:
-        from benchmark.scoring import ap_by_distance, od50
+        from benchmark.scoring import ap_by_distance, od50, working_point
         from metricscenes import __version__
 
         collection, camera, timings = self.collection, self.camera, self.timings
         geometry = _geometry_record(camera, self.field, self.window)
         t = time.perf_counter()
         per_distance = ap_by_distance(groundtruth, detections, backend=self.backend)
+        working = working_point(groundtruth, detections)  # miss rate and false positives per image beside AP
         timings.add("score", t)
         detections_bytes = json.dumps(detections, separators=(",", ":")).encode()
-        per_distance = [DistanceAP(**row) for row in per_distance]
+        per_distance = [DistanceAP(**row, **working[row["distance_m"]]) for row in per_distance]
         detector_record = DetectorRecord(name=detector.name, family=detector.family, sha256=detector.sha256,
                                          input_size=detector.input_size, score_threshold=AP_SCORE_THRESHOLD,
                                          multi_label=True)

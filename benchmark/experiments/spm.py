@@ -227,6 +227,10 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
 
     The OD50 axis is scaled to what is drawn (:func:`_axis_top_m`): the fitted OD50s, the
     bounds and the measured distances, never the extrapolated number behind a bound.
+
+    With an ``n_environments`` column, OD50s from fewer than
+    :data:`benchmark.scoring.MIN_ENVIRONMENTS` environments are drawn but not fitted: no line is
+    drawn through a sample too small for a verdict (docs/scoring.md), and the legend says so.
     """
     x, x_label, x_unit = MTF50_AXES[axis]
     _require(od50_table, ("condition", x, "od50_m", "sd_m"))
@@ -248,8 +252,11 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
         part = finite[finite["condition"] == condition]
         fitted, outside = part[part["fitted"]], part[~part["fitted"]]
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
-        slope, intercept = fit_line(fitted[x], fitted["od50_m"])
+        few = _too_few(fitted)
+        slope, intercept = fit_line(fitted.loc[~few, x], fitted.loc[~few, "od50_m"])
         label = f"{condition}: slope {slope:.2f} m per {x_unit}" if np.isfinite(slope) else f"{condition}: no fit"
+        if few.any():  # (the page says why beside the table: benchmark.scoring.sample_too_small_text)
+            label += f" ({few.sum()} from too few environments: not fitted)"
         if len(outside) and censored:
             label += f" ({_bounds_text(outside)}: hollow, not fitted)"
         elif len(outside):
@@ -267,7 +274,7 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
                 ax.errorbar(points[x], np.minimum(points["od50_m"], top),
                             yerr=_error_bars(points, top), fmt="o", color=colour, capsize=3, **style)
         if np.isfinite(slope):
-            xs = np.linspace(fitted[x].min(), fitted[x].max(), 2)
+            xs = np.linspace(fitted.loc[~few, x].min(), fitted.loc[~few, x].max(), 2)
             ax.plot(xs, slope * xs + intercept, "-", color=colour, lw=1.2)
     interval = {"ci95_lo_m", "ci95_hi_m"} <= set(od50_table.columns)
     ax.set(xlabel=x_label, ylabel="OD50 (m)", ylim=(0, top),
@@ -277,6 +284,15 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
     if out is not None:
         save_figure(fig, out)
     return fig
+
+
+def _too_few(points: pd.DataFrame) -> pd.Series:
+    """Per point: True where its OD50 rests on too few environments to be fitted (:func:`benchmark.scoring.too_few`)."""
+    from benchmark.scoring import too_few
+
+    if "n_environments" not in points.columns:
+        return pd.Series(False, index=points.index)
+    return points["n_environments"].map(too_few).astype(bool)
 
 
 def _bounds_text(points: pd.DataFrame) -> str:

@@ -25,8 +25,10 @@ Outputs (DESIGN §4; Liu et al., EI 2023, Figs. 5-7), their schemas in :mod:`ben
   ap, ap50, n_images, focal_length_mm, mtf50_cy_per_mrad`` (:class:`~benchmark.result_files.SweepRow`;
   sweep.json: :class:`~benchmark.result_files.SweepRecord`);
 - ``od50.csv``: one row per camera × condition with OD50, its bootstrap SD over
-  environments and the 95 % percentile interval (:func:`benchmark.scoring.bootstrap_od50`;
-  :class:`~benchmark.result_files.Od50Row`).
+  environments and the 95 % percentile interval, and the same for the AP range (area under
+  AP vs distance) (:func:`benchmark.scoring.bootstrap_od50`;
+  :class:`~benchmark.result_files.Od50Row`). Tables mark a figure from fewer than
+  :data:`benchmark.scoring.MIN_ENVIRONMENTS` environments with :data:`benchmark.scoring.FEW_MARK`.
 
 MTF50 comes from :func:`benchmark.measure.mtf.camera_mtf50` from ``mtf_source`` on: ``measured``
 (ISO 12233 slanted edge through the camera), ``analytic`` (diffraction × pixel aperture)
@@ -144,7 +146,7 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     cache = run_dir / "od50.json"
     try:
         stored = read_od50_cache(cache)
-        if stored.key == key:
+        if stored.key == key and stored.od50.ap_range_m is not None:  # (older caches lack the AP range: redone)
             return stored.od50
     except (OSError, ResultsFileError):
         pass  # none yet, or unreadable: computed again
@@ -464,9 +466,12 @@ def _write_sweep(out_dir: Path, collection, cameras: list, conditions: list[str]
                                      n_images=r.n_images))
             boot = run_od50(run_dir, n_resamples=n_resamples, seed=seed)
             lo, hi = boot.ci95_m
+            range_lo, range_hi = boot.ap_range_ci95_m
             od50_rows.append(Od50Row(**ident, condition=condition, od50_m=boot.od50_m, sd_m=boot.sd_m, ci95_lo_m=lo,
                                      ci95_hi_m=hi, n_resamples=boot.n_resamples, n_environments=boot.n_environments,
-                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0]))
+                                     n_infinite=boot.n_infinite, censored=run_results.od50_censoring()[0],
+                                     ap_range_m=boot.ap_range_m, ap_range_sd_m=boot.ap_range_sd_m,
+                                     ap_range_ci95_lo_m=range_lo, ap_range_ci95_hi_m=range_hi))
 
     table = write_sweep_table(out_dir / "sweep.csv", rows)
     od50_table = write_od50_table(out_dir / "od50.csv", od50_rows)
@@ -523,10 +528,24 @@ def with_censoring(od50: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
 
 
 def od50_cell(row) -> str:
-    """One od50.csv row for people: "123.4 ± 5.6", "> 200" or "< 25" (censored: a bound), "∞"."""
+    """One od50.csv row for people: "123.4 ± 5.6", "> 200" or "< 25" (censored: a bound), "∞";
+    "†" appended where it rests on too few environments (:func:`benchmark.scoring.mark_few`)."""
+    from benchmark.scoring import mark_few
     from benchmark.scoring.od50 import format_od50
 
     censored = str(row.get("censored", "") or "")
     bound = row.get("bound_m")
     bound = None if bound is None or bound != bound else float(bound)
-    return format_od50(row["od50_m"], censored, bound, row.get("sd_m"), unit="")
+    return mark_few(format_od50(row["od50_m"], censored, bound, row.get("sd_m"), unit=""), row.get("n_environments"))
+
+
+def ap_range_cell(row) -> str:
+    """The AP range of one od50.csv row for people: "156.8 ± 4.1" ("–" in sweeps written before
+    it was recorded), marked as :func:`od50_cell` is."""
+    from benchmark.scoring import mark_few
+
+    value, sd = row.get("ap_range_m"), row.get("ap_range_sd_m")
+    if value is None or value != value:
+        return "–"
+    text = f"{float(value):.1f}" + (f" ± {float(sd):.1f}" if sd is not None and sd == sd else "")
+    return mark_few(text, row.get("n_environments"))

@@ -1,8 +1,10 @@
 """Render the leaderboard (``README.md`` and ``index.html``) from ``submissions/*.json``.
 
 Deterministic: the output depends only on the submissions (and the accepted protocols):
-rows are ranked by daylight OD50, then night OD50 (missing = last), then name; the only
-date shown is the newest submission's ``created_at``. Both files are written atomically
+rows are ranked by daylight OD50, then night OD50 (missing = last), then name, a censored OD50
+by its tier and the AP range (:func:`od50_sort_value`); the only date shown is the newest
+submission's ``created_at``. OD50 and AP range from fewer than
+:data:`benchmark.scoring.MIN_ENVIRONMENTS` environments carry :data:`benchmark.scoring.FEW_MARK`. Both files are written atomically
 (:func:`metricscenes.files.write_atomic`) and only after every submission
 has validated, so a bad submission or an interrupted render leaves the old table intact.
 
@@ -24,6 +26,7 @@ from importlib import resources
 from pathlib import Path
 
 from benchmark.leaderboard.protocols import Protocol, load_protocols
+from benchmark.scoring.sample import few_footnote
 from benchmark.leaderboard.validate import SUBMISSIONS, duplicate_problem, read_submission_file, validate_submission
 from metricscenes.files import write_atomic
 
@@ -79,15 +82,25 @@ def censoring(cond: dict) -> tuple[str, float | None, float | None]:
     return censored, bound, at
 
 
+def ap_range_of(cond: dict | None) -> float | None:
+    """The AP range (m) of one condition entry from its per-distance AP
+    (:func:`benchmark.scoring.ap_range`); None: absent, or no finite AP."""
+    from benchmark.scoring import ap_range
+
+    rows = [r for r in (cond or {}).get("per_distance") or [] if r.get("ap") is not None and math.isfinite(float(r["ap"]))]
+    return ap_range([r["distance_m"] for r in rows], [r["ap"] for r in rows]) if rows else None
+
+
 def od50_sort_value(cond: dict | None) -> float | None:
     """The number a condition is ranked by (higher is better; None: absent):
-    :func:`benchmark.scoring.od50.od50_rank_value` of its OD50, censored from its per-distance AP."""
+    :func:`benchmark.scoring.od50.od50_rank_value` of its OD50, censored from its per-distance AP,
+    a censored one ranked within its tier by the AP range (:func:`ap_range_of`)."""
     from benchmark.scoring.od50 import od50_rank_value
 
     if cond is None:
         return None
-    censored, bound, at = censoring(cond)
-    return od50_rank_value(cond["od50_m"], censored, bound, at)
+    censored, bound, _ = censoring(cond)
+    return od50_rank_value(cond["od50_m"], censored, bound, ap_range_m=ap_range_of(cond))
 
 
 def rank_key(sub: dict) -> tuple:
@@ -105,15 +118,38 @@ def ranked(submissions: list[dict]) -> list[dict]:
 def _fmt_od50(cond: dict | None) -> tuple[str, str]:
     """(sort value, text) of one condition's OD50 ± SD; censored: the bound ("> 200", "< 25"),
     no ±, and :func:`od50_sort_value` as sort value (never the extrapolated number)."""
+    from benchmark.scoring import mark_few
+
     if cond is None:
         return "", "–"
     censored, bound, _ = censoring(cond)
     if censored:
         value = od50_sort_value(cond)
-        return ("Infinity" if value == math.inf else repr(float(value))), (f"{censored} {bound:g}" if bound is not None else "∞")
+        text = f"{censored} {bound:g}" if bound is not None else "∞"
+        return ("Infinity" if value == math.inf else repr(float(value))), mark_few(text, cond.get("n_environments"))
     sd = cond["od50_sd_m"]
     text = f"{cond['od50_m']:.1f}" + (f" ± {sd:.1f}" if sd is not None else "")
-    return repr(float(cond["od50_m"])), text
+    return repr(float(cond["od50_m"])), mark_few(text, cond.get("n_environments"))
+
+
+def _fmt_ap_range(cond: dict | None) -> tuple[str, str]:
+    """(sort value, text) of one condition's AP range (m), marked as the OD50 is."""
+    from benchmark.scoring import mark_few
+
+    value = ap_range_of(cond)
+    if value is None:
+        return "", "–"
+    return repr(float(value)), mark_few(f"{value:.1f}", cond.get("n_environments"))
+
+
+RANKED_CONDITIONS = ("day", "night")
+"""The conditions the rank reads, in order; their AP range is shown beside the OD50s."""
+
+
+def _few(submissions: list[dict]) -> bool:
+    from benchmark.scoring import too_few
+
+    return any(too_few(c.get("n_environments")) for s in submissions for c in s["conditions"].values())
 
 
 def _resamples(submissions: list[dict]) -> str:
@@ -125,9 +161,16 @@ def _num(value, fmt: str) -> tuple[str, str]:
     return ("", "–") if value is None else (repr(float(value)), format(value, fmt))
 
 
+def _title(condition: str) -> str:
+    """A condition as a column header: "Night regulation" (a space lets the header wrap)."""
+    return condition.replace("_", " ").capitalize()
+
+
 def columns(protocol: Protocol) -> list[Column]:
-    od50 = [Column(f"{c}_od50", f"{c.capitalize()} OD50 (m)", "num") for c in protocol.conditions]
-    return [Column("rank", "#", "num"), Column("system", "System", "str"), Column("camera", "Camera", "str"), *od50,
+    od50 = [Column(f"{c}_od50", f"{_title(c)} OD50 (m)", "num") for c in protocol.conditions]
+    ranges = [Column(f"{c}_ap_range", f"{_title(c)} AP range (m)", "num") for c in RANKED_CONDITIONS
+              if c in protocol.conditions]
+    return [Column("rank", "#", "num"), Column("system", "System", "str"), Column("camera", "Camera", "str"), *od50, *ranges,
             Column("mtf50", "MTF50 (cy/mm)", "num"), Column("mtf50_mrad", "MTF50 (cy/mrad)", "num"),
             Column("focal_mm", "Focal (mm)", "num"), Column("fov", "FOV (°)", "num"),
             Column("pixel_um", "Pixel (µm)", "num"),
@@ -156,6 +199,8 @@ def row_cells(rank: int, sub: dict, protocol: Protocol) -> dict[str, tuple[str, 
     cells = {"rank": (str(rank), str(rank)), "system": (sub["name"], sub["name"]), "camera": (sub["camera"]["name"],) * 2}
     for c in protocol.conditions:
         cells[f"{c}_od50"] = _fmt_od50(sub["conditions"].get(c))
+        if c in RANKED_CONDITIONS:
+            cells[f"{c}_ap_range"] = _fmt_ap_range(sub["conditions"].get(c))
     group = " (group)" if sub["camera"]["mtf50_source"] == "published_group" else ""
     mtf_sort, mtf_text = _num(mtf, ".0f")
     mrad_sort, mrad_text = _num(cy_per_mrad(mtf, focal), ".2f")
@@ -197,13 +242,15 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
         "systems by **daylight OD50**, the distance at which COCO AP of the car falls to 0.5 (Liu et al.,",
         f"EI 2023), then by night OD50. ± is the bootstrap SD over environments ({_resamples(submissions)}).",
         "Censored OD50s show a bound: \\> 200 when AP has not yet fallen to 0.5 at the farthest distance (a",
-        "lower bound; ranked above every measured OD50, ties broken by AP at the farthest distance), \\< 25",
-        "when AP is below 0.5 already at the nearest (ranked below every measured OD50, by AP at the nearest",
-        "distance); an extrapolated OD50 is neither shown nor ranked by. MTF50 is measured on the camera's",
+        "lower bound; ranked above every measured OD50), \\< 25 when AP is below 0.5 already at the nearest",
+        "(ranked below every measured OD50); among themselves both rank by the **AP range**, the area under",
+        "AP vs distance in metres (defined for every camera; shown for day and night). An extrapolated OD50",
+        "is neither shown nor ranked by, and no tie is broken by AP at one distance. MTF50 is measured on the camera's",
         "simulated slanted edge (ISO 12233), or the paper's published group where marked, in cycles/mm on",
         "the sensor and in cycles/mrad in object space (× focal length / 1000): only the angular figure",
         "compares cameras whose focal lengths differ. Open [index.html](index.html) for a sortable table;",
         "see [docs/leaderboard.md](../docs/leaderboard.md) for the submission format and rules.", "",
+        *([_md(few_footnote()) + ".", ""] if _few(submissions) else []),
         f"{len(submissions)} submission(s)" + (f"; newest {latest}." if latest else "."), "",
     ]  # fmt: skip
     for protocol, subs in _by_protocol(submissions, protocols):
@@ -254,10 +301,12 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
         "<h1>metricscenes leaderboard</h1>",
         "<p>Ranked by daylight OD50 (distance at which COCO AP of the car falls to 0.5), then night OD50. "
         f"± is the bootstrap SD over environments ({esc(_resamples(submissions))}). &gt; 200: AP has not yet fallen "
-        "to 0.5 at the farthest distance (a lower bound; ranked above every measured OD50, ties broken by AP at the "
-        "farthest distance); &lt; 25: below 0.5 already at the nearest (ranked below every measured OD50, by AP at the "
-        "nearest). MTF50 in cycles/mm on the sensor and in cycles/mrad in object space (× focal length / 1000): "
+        "to 0.5 at the farthest distance (a lower bound; ranked above every measured OD50); &lt; 25: below 0.5 already "
+        "at the nearest (ranked below every measured OD50); among themselves both rank by the AP range, the area under "
+        "AP vs distance in metres (defined for every camera; shown for day and night); no tie is broken by AP at one "
+        "distance. MTF50 in cycles/mm on the sensor and in cycles/mrad in object space (× focal length / 1000): "
         "only the angular figure compares cameras whose focal lengths differ. Click a column to sort.</p>",
+        *([f'<p class="meta">{esc(few_footnote())}.</p>'] if _few(submissions) else []),
         f'<p class="meta">{len(submissions)} submission(s)' + (f"; newest {esc(latest)}" if latest else "") + ".</p>",
     ]  # fmt: skip
     for protocol, subs in _by_protocol(submissions, protocols):

@@ -17,6 +17,7 @@ import pandas as pd
 from benchmark.experiments.acceptance import ap_distance_rho
 from benchmark.experiments.sweep import od50_cell, with_censoring
 from benchmark.publish.sweep_tables import POLICY_CONDITIONS, REFERENCE_POLICY
+from benchmark.scoring.ap_range import ap_range
 from benchmark.scoring.od50 import od50_rank_value
 
 NIGHTS = ("night", "night_regulation")  # the paper's night, then the unlit regulation road
@@ -168,7 +169,8 @@ def rank_value(row, ap: pd.Series) -> float:
     """A row of :func:`_load`'s od50 table (its ``censored`` and ``bound_m``) to rank by, by the
     leaderboard's rule (:func:`benchmark.scoring.od50.od50_rank_value`; ``ap``: the camera's AP by distance)."""
     bound = float(row["bound_m"]) if row["censored"] else None
-    return od50_rank_value(row["od50_m"], row["censored"], bound, None if bound is None else ap[bound])
+    return od50_rank_value(row["od50_m"], row["censored"], bound,
+                           ap_range_m=ap_range(list(ap.index), list(ap.values)))
 
 
 def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tuple[str, str], condition: str) -> str:

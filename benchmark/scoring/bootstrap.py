@@ -15,7 +15,12 @@ The only difference left: exact score ties *between different images* are ordere
 original image order instead of the resample's.
 
 Resampling and the percentile interval come from ``scipy.stats.bootstrap`` (``percentile``
-method; BCa is not used because OD50 can be +inf for a resample).
+method; BCa is not used because OD50 can be +inf for a resample). The AP range
+(:mod:`benchmark.scoring.ap_range`) is computed from the same resampled AP curves as OD50.
+
+**Point inside its interval.** On few environments the full-sample value can fall outside
+the percentile interval of its resamples; every interval reported goes through
+:func:`enclose`: [min(lo, point), max(hi, point)] (docs/scoring.md).
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from scipy import stats
 
 from benchmark.record_base import Censored, JsonFloat, Record
 from benchmark.scoring.ap import ALL_AREAS, MAX_DETS, ap_by_distance, images_by_distance
+from benchmark.scoring.ap_range import ap_range
 from benchmark.scoring.od50 import od50, od50_censoring
 
 REC_THRS = np.linspace(0.0, 1.00, 101)  # COCO recall thresholds
@@ -42,7 +48,8 @@ class Od50Bootstrap(Record):
     ``od50.json`` caches (:class:`benchmark.result_files.Od50Cache`).
 
     Caches written before censoring was recorded lack ``censored`` and ``bound_m``; hand-made
-    ones may lack the counts.
+    ones may lack the counts; caches written before the AP range lack ``ap_range_*`` (and their
+    intervals may not hold the point): ``run_od50`` computes those again.
     """
 
     od50_m: JsonFloat  # of the full set, m; +inf where AP never falls to 0.5; extrapolated where censored
@@ -53,6 +60,9 @@ class Od50Bootstrap(Record):
     n_infinite: int | None = None  # resamples whose OD50 is +inf (they still enter the interval)
     censored: Censored | None = None  # of the full set (benchmark.scoring.od50.od50_censoring)
     bound_m: float | None = None  # the farthest (">") or nearest ("<") measured distance; None when not censored
+    ap_range_m: float | None = None  # area under AP vs distance of the full set, m (benchmark.scoring.ap_range)
+    ap_range_sd_m: float | None = None  # SD (ddof 1) of the resampled AP ranges, m
+    ap_range_ci95_m: tuple[float, float] | None = None  # percentile interval of the AP range, m, enclosing the point
 
 
 def resample_environments(groundtruth: dict, detections: list[dict], environments) -> tuple[dict, list[dict]]:
@@ -181,13 +191,16 @@ def bootstrap_od50(
     category_id: int = 3,
     confidence_level: float = 0.95,
 ) -> Od50Bootstrap:
-    """OD50 (from the full set, ``backend``) with its bootstrap SD and percentile CI over environments.
+    """OD50 and AP range (from the full set, ``backend``) with their bootstrap SD and percentile
+    CI over environments, from the same resamples.
 
     Returns an :class:`Od50Bootstrap`: ``od50_m``, ``sd_m``,
     ``ci95_m`` (lo, hi), ``n_resamples``, ``n_environments``, ``n_infinite``, ``censored``
-    and ``bound_m`` ("", ">" or "<" of the full set and its bound, :func:`od50_censoring`);
+    and ``bound_m`` ("", ">" or "<" of the full set and its bound, :func:`od50_censoring`),
+    ``ap_range_m``, ``ap_range_sd_m``, ``ap_range_ci95_m``;
     ``sd_m`` is the SD (ddof 1) of the finite resampled OD50s, ``n_infinite`` counts
-    resamples whose AP never falls to 0.5 (OD50 = inf; they still enter the CI).
+    resamples whose AP never falls to 0.5 (OD50 = inf; they still enter the CI). Both
+    intervals enclose their point (:func:`enclose`).
     """
     if n_resamples < 2:
         raise ValueError(f"n_resamples must be >= 2, got {n_resamples}")
@@ -196,14 +209,16 @@ def bootstrap_od50(
         raise ValueError(f"bootstrap needs two or more environments, got {len(envs)}")
     env_index = {e: k for k, e in enumerate(envs)}
     rows = ap_by_distance(groundtruth, detections, backend=backend, category_id=category_id)
-    point = od50([r["distance_m"] for r in rows], [r["ap"] for r in rows])
-    censored, bound_m = od50_censoring([r["distance_m"] for r in rows], [r["ap"] for r in rows])
+    curve = ([r["distance_m"] for r in rows], [r["ap"] for r in rows])
+    point, range_point = od50(*curve), ap_range(*curve)
+    censored, bound_m = od50_censoring(*curve)
     tables = _match_tables(groundtruth, detections, category_id, env_index)
     distances = list(tables)
 
-    def statistic(sample: np.ndarray) -> float:
+    def statistic(sample: np.ndarray) -> np.ndarray:
         w = np.bincount(sample.astype(np.int64), minlength=len(envs))
-        return od50(distances, [weighted_ap(tables[d], w)[0] for d in distances])
+        ap = [weighted_ap(tables[d], w)[0] for d in distances]
+        return np.array([od50(distances, ap), ap_range(distances, ap)])
 
     res = stats.bootstrap(
         (np.arange(len(envs)),),
@@ -214,9 +229,9 @@ def bootstrap_od50(
         confidence_level=confidence_level,
         rng=np.random.default_rng(seed),
     )
-    dist = np.asarray(res.bootstrap_distribution, dtype=np.float64)
+    dist, ranges = np.asarray(res.bootstrap_distribution, dtype=np.float64)
     finite = dist[np.isfinite(dist)]
-    lo, hi = percentile_interval(dist, confidence_level)
+    lo, hi = enclose(point, *percentile_interval(dist, confidence_level))
     return Od50Bootstrap(
         od50_m=float(point),
         sd_m=float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
@@ -226,7 +241,20 @@ def bootstrap_od50(
         n_infinite=int(dist.size - finite.size),
         censored=censored,
         bound_m=bound_m,
+        ap_range_m=float(range_point),
+        ap_range_sd_m=float(np.std(ranges, ddof=1)),
+        ap_range_ci95_m=enclose(range_point, *percentile_interval(ranges, confidence_level)),
     )
+
+
+def enclose(point: float, lo: float, hi: float) -> tuple[float, float]:
+    """[min(lo, point), max(hi, point)]: the interval reported, which always holds its point. On
+    few environments the percentile interval can miss the full-sample value (its resamples
+    cluster on one side); the interval is widened to it rather than shown beside it. NaN
+    ends or point: unchanged."""
+    if point != point or lo != lo or hi != hi:
+        return float(lo), float(hi)
+    return float(min(lo, point)), float(max(hi, point))
 
 
 def percentile_interval(values: np.ndarray, confidence_level: float = 0.95) -> tuple[float, float]:

@@ -96,20 +96,30 @@ def od50_censoring(distances_m, ap, *, level: float = AP_LEVEL) -> tuple[str, fl
     return CENSORED_BELOW, float(d[0])
 
 
-def od50_rank_value(od50_m, censored: str = "", bound_m: float | None = None, ap_at_bound: float | None = None) -> float:
+def od50_rank_value(od50_m, censored: str = "", bound_m: float | None = None, ap_at_bound: float | None = None, *,
+                    ap_range_m: float | None = None) -> float:
     """The number an OD50 is ranked by, higher better (docs/leaderboard.md, "Censored OD50 and the rank rule").
 
     A measured OD50 ranks by its value. ``">"`` ranks above every measured one (a measured OD50
-    is at most the farthest distance): ``bound_m + ap_at_bound``, in [D_far + 0.5, D_far + 1],
-    so ties among them break by AP there (infinite with no bound). ``"<"`` ranks below every
-    measured one: ``bound_m × ap_at_bound``, below D_near / 2, so one that nearly reaches AP 0.5
-    ranks above one that sees nothing. An extrapolated OD50 is never the key.
+    is below the farthest distance) and ``"<"`` below every measured one (a measured OD50 is at
+    least the nearest); within each, by the AP range ``ap_range_m`` (area under AP vs distance,
+    :func:`benchmark.scoring.ap_range.ap_range`), squashed by s = x / (x + bound) into [0, 1) so it
+    stays in its tier: ``bound_m + s`` for ">" (infinite with no bound), ``bound_m × s`` for "<".
+    An extrapolated OD50 is never the key.
+
+    ``ap_at_bound`` (AP at the bound, the rule before the AP range) is used only where
+    ``ap_range_m`` is not given, for callers that still pass it; it breaks ties by one distance's AP.
     """
-    if censored == CENSORED_ABOVE:
-        return math.inf if bound_m is None else float(bound_m) + float(ap_at_bound)
-    if censored == CENSORED_BELOW:
-        return float(bound_m) * float(ap_at_bound)
-    return float(od50_m)
+    if censored not in (CENSORED_ABOVE, CENSORED_BELOW):
+        return float(od50_m)
+    if censored == CENSORED_ABOVE and bound_m is None:
+        return math.inf
+    bound = float(bound_m)
+    if ap_range_m is None:  # the older rule, AP at the bound
+        return bound + float(ap_at_bound) if censored == CENSORED_ABOVE else bound * float(ap_at_bound)
+    x = max(0.0, float(ap_range_m))
+    squashed = x / (x + bound) if x + bound > 0 else 0.0
+    return bound + squashed if censored == CENSORED_ABOVE else bound * squashed
 
 
 def format_od50(od50_m, censored: str = "", bound_m: float | None = None, sd_m=None, *, unit: str = " m") -> str:
