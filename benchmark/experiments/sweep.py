@@ -41,6 +41,7 @@ import json
 import os
 import warnings
 from contextlib import ExitStack, closing
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterable
 
@@ -159,27 +160,43 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     return out
 
 
-def compute_runs(collection, cameras: list, condition: str, detector, run_dirs: list[Path], seed: int,
-                 save_images: bool, backend: str, n_resamples: int, progress=None,
-                 captures: list[Path | None] | None = None,
-                 also: dict | None = None, group_luminances: dict | None = None) -> list[tuple[str, str, RunResults]]:
-    """Several cameras' runs under one condition (:func:`benchmark.experiments.run.run_cameras`:
-    each scene read once for all of them) and their bootstrap OD50s, in whichever process the
-    sweep's backend gives them: everything they write is in ``run_dirs`` (``od50.json`` too),
-    which no other unit touches (``captures``, another sweep's run folders, are only read),
-    and in ``also`` ({input size: run folders}: the runs of the detector's passes).
-    ``group_luminances``: a targeted condition's light-group luminances measured already
-    (:func:`shared_group_luminances`). Returns (camera name, condition, results) per camera."""
+@dataclass(frozen=True)
+class SweepUnit:
+    """One unit of a sweep: several cameras' runs under one condition, computed together in
+    whichever process the sweep's backend gives it (:func:`compute_runs`). Everything the unit
+    writes is in ``run_dirs`` (``od50.json`` too), which no other unit touches; ``captures``
+    (another sweep's run folders, one per camera or None) are only read; ``also`` ({input size:
+    run folders}) holds the runs of the detector's other passes; ``group_luminances``: a
+    targeted condition's light-group luminances measured already (:func:`shared_group_luminances`)."""
+
+    collection: object
+    cameras: list
+    condition: str
+    detector: object
+    run_dirs: list[Path]
+    seed: int
+    save_images: bool
+    backend: str
+    n_resamples: int
+    progress: object = None
+    captures: list[Path | None] | None = None
+    also: dict | None = None
+    group_luminances: dict | None = None
+
+
+def compute_runs(unit: SweepUnit) -> list[tuple[str, str, RunResults]]:
+    """A unit's runs (:func:`benchmark.experiments.run.run_cameras`: each scene read once for all
+    its cameras) and their bootstrap OD50s. Returns (camera name, condition, results) per camera."""
     from benchmark.experiments import run as run_module
     from metricscenes.store import remember_group_luminances
 
-    remember_group_luminances(group_luminances or {})
-    results = run_module.run_cameras(collection, cameras, condition, detector, run_dirs, seed=seed,
-                                     save_images=save_images, backend=backend, progress=progress, captures=captures,
-                                     also=also)
-    for run_dir in [*run_dirs, *(d for dirs in (also or {}).values() for d in dirs)]:
-        run_od50(run_dir, n_resamples=n_resamples, seed=seed)  # cached in the run folder for the table
-    return [(camera.name, condition, r) for camera, r in zip(cameras, results)]
+    remember_group_luminances(unit.group_luminances or {})
+    results = run_module.run_cameras(unit.collection, unit.cameras, unit.condition, unit.detector, unit.run_dirs,
+                                     seed=unit.seed, save_images=unit.save_images, backend=unit.backend,
+                                     progress=unit.progress, captures=unit.captures, also=unit.also)
+    for run_dir in [*unit.run_dirs, *(d for dirs in (unit.also or {}).values() for d in dirs)]:
+        run_od50(run_dir, n_resamples=unit.n_resamples, seed=unit.seed)  # cached in the run folder for the table
+    return [(camera.name, unit.condition, r) for camera, r in zip(unit.cameras, results)]
 
 
 def measure_group_luminances(collection, scene_ids: list[str], conditions: list[str]) -> dict[str, dict]:
@@ -401,11 +418,12 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                 n_groups = 1 if in_process else len(pending) if is_remote(scheduler) else max(1, workers)
                 for group in camera_groups(pending, n_groups):
                     label = f"{'+'.join(c.name for c in group)} · {condition}"
-                    jobs.append((collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
-                                 seed, save_images, backend, n_resamples, scene_progress(label, len(group)),
-                                 [captures(c, condition) for c in group],
-                                 {size: [run_dirs[size, c.name, condition] for c in group] for size in also},
-                                 luminances.get(condition)))
+                    jobs.append((SweepUnit(
+                        collection, group, condition, detector, [run_dirs[None, c.name, condition] for c in group],
+                        seed, save_images, backend, n_resamples, progress=scene_progress(label, len(group)),
+                        captures=[captures(c, condition) for c in group],
+                        also={size: [run_dirs[size, c.name, condition] for c in group] for size in also},
+                        group_luminances=luminances.get(condition)),))
             with closing(map_units(compute_runs, jobs, workers=workers, scheduler=scheduler)) as finished:
                 for finished_runs in finished:  # in the order they finish
                     for camera_name, condition, run_results in finished_runs:
