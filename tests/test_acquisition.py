@@ -21,7 +21,8 @@ from benchmark.camera.calibration import illuminant_spectrum
 from benchmark.camera.exposure import parse_exposure, with_exposure
 from benchmark.camera.pipeline import simulate
 from benchmark.camera.registry import DATA_DIR
-from benchmark.camera.spec import SensorSpec, file_sha256
+from benchmark.camera.spec_files import file_sha256
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.measure.mtf import measure_mtf50
 from benchmark.measure.photon_transfer import datasheet_figures, photon_transfer
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
@@ -117,7 +118,7 @@ def test_the_mtf_bench_runs_the_cameras_acquisition_and_isp_as_before():
     cam12 = measure_mtf50(load_camera("cam12"))
     assert cam12["mtf50_cy_per_mm"] == 229.34639770214133
     assert _sha(cam12["mtf"]) == "44351f65719baab7a47282c7882c213a1f4a30ac796757009219139952819adc"
-    from benchmark.camera.spec import isp_preset
+    from benchmark.camera.spec_isp import isp_preset
     cam01 = measure_mtf50(load_camera("cam01").model_copy(update={"isp": isp_preset("iset-parity")}), esfr="isetcam")
     assert cam01["mtf50_cy_per_mm"] == 56.6
     assert _sha(cam01["mtf"]) == "4aea341670bdaac06eb0ca67496373067bd31420ffd361829080c22db20afe80"

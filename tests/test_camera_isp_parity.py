@@ -12,7 +12,8 @@ from typer.testing import CliRunner
 from benchmark.camera import calibration, isp
 from benchmark.camera import sensor as sensor_module
 from benchmark.camera import list_cameras, load_camera
-from benchmark.camera.spec import CameraSpec, ISPSpec, isp_preset
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_isp import ISPSpec, isp_preset
 from benchmark.cli.cameras import app
 from benchmark.measure.mtf import (
     LUMINANCE_WEIGHTS,

@@ -15,7 +15,8 @@ from scipy.special import j0, j1
 
 from benchmark.camera import camera_from_dict, camera_names, lens, load_camera, optics, sensor
 from benchmark.camera.pipeline import electron_rate, optical_image, simulate
-from benchmark.camera.spec import ExposureSpec, OpticsSpec
+from benchmark.camera.spec_exposure import ExposureSpec
+from benchmark.camera.spec_optics import OpticsSpec
 from benchmark.measure.mtf import mtf50_analytic_cy_per_mm
 from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
 from metricscenes.radiance import RadianceLayer, SpectralScene

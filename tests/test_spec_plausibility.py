@@ -14,7 +14,9 @@ import pytest
 from typer.testing import CliRunner
 
 from benchmark.camera import list_cameras, load_camera
-from benchmark.camera.spec import PLAUSIBLE, check_qe_table, cy_per_mrad
+from benchmark.camera.spec import cy_per_mrad
+from benchmark.camera.spec_files import check_qe_table
+from benchmark.camera.spec_rules import PLAUSIBLE
 from benchmark.cli.main import app
 from metricscenes.spectral import SENSOR_DATA_DIR
 
@@ -92,7 +94,7 @@ def test_unusual_but_possible_values_are_warned_about_not_refused(tmp_path):
 
 def test_registry_cameras_are_plausible_and_unchanged():
     """The 13 cameras pass every bound and draw no plausibility warning; their sha256 stay."""
-    from benchmark.camera.spec import plausibility_warnings
+    from benchmark.camera.spec_rules import plausibility_warnings
 
     for cam in list_cameras():
         assert plausibility_warnings(cam) == []

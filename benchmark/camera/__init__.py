@@ -11,7 +11,11 @@ from benchmark.camera.registry import (
     list_cameras,
     load_camera,
 )
-from benchmark.camera.spec import CameraSpec, ExposureSpec, ISPSpec, OpticsSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_exposure import ExposureSpec
+from benchmark.camera.spec_isp import ISPSpec
+from benchmark.camera.spec_optics import OpticsSpec
+from benchmark.camera.spec_sensor import SensorSpec
 
 __all__ = [
     "DATA_DIR",

@@ -29,7 +29,8 @@ import numpy as np
 from benchmark.camera import dual_gain as _dual_gain
 from benchmark.camera import exposure as _exposure
 from benchmark.camera import sensor as _sensor
-from benchmark.camera.spec import CameraSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_sensor import SensorSpec
 
 STRATEGIES = ("single", "two_frame_hdr", "dual_gain")
 """The acquisition strategies (:attr:`RawCapture.strategy`), one function each."""

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import colour
 import numpy as np
 
-from benchmark.camera.spec import ISPSpec, SensorSpec
+from benchmark.camera.spec_isp import ISPSpec
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.camera.sensor import channel_responsivity
 from metricscenes.photometry import cie_1931_cmfs
 from metricscenes.spectral import WAVELENGTHS_NM, resample_spectrum

@@ -51,7 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from benchmark.camera import sensor as _sensor
-from benchmark.camera.spec import SensorSpec
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.camera.spec_readout import readout_saturation_e
 
 

@@ -21,7 +21,9 @@ from typing import NamedTuple
 import numpy as np
 from pydantic import ValidationError
 
-from benchmark.camera.spec import CameraSpec, ExposureSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_exposure import ExposureSpec
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.camera.sensor import signal_volts_per_electron
 
 EXPOSURE_SYNTAX = ("auto_peak | mean_level | percentile:P | hdr[:RATIO] | fixed:SECONDS, "

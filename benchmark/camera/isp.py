@@ -22,7 +22,8 @@ import colour_demosaicing
 import numpy as np
 
 from benchmark.camera.calibration import Calibration
-from benchmark.camera.spec import ISPSpec, SensorSpec
+from benchmark.camera.spec_isp import ISPSpec
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.camera.demosaic import malvar2004
 from benchmark.camera.sensor import bayer_sites, cfa_channels
 

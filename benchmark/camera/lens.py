@@ -2,7 +2,7 @@
 every stage that needs it — the camera's optics (:mod:`benchmark.camera.optics`), the
 analytic MTF50 (:func:`benchmark.measure.mtf.mtf50_analytic_cy_per_mm`) and the benchmarks.
 
-A lens (an :class:`~benchmark.camera.spec.OpticsSpec`) forms its image through one of
+A lens (an :class:`~benchmark.camera.spec_optics.OpticsSpec`) forms its image through one of
 
 * **a clear circular pupil** (the default, the paper's diffraction-limited lenses) at
   f-number N: Goodman, *Introduction to Fourier Optics*, 3rd ed., eq. 6-32, with cutoff

@@ -39,7 +39,7 @@ import numpy as np
 import scipy.fft as sfft
 
 from benchmark.camera import lens as _lens
-from benchmark.camera.spec import OpticsSpec
+from benchmark.camera.spec_optics import OpticsSpec
 from metricscenes.radiance import band_planes
 
 FFT_WORKERS = 2

@@ -18,7 +18,8 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from benchmark.camera.spec import PACKAGE_DATA_DIR, SPEC_DIR_CONTEXT, CameraSpec
+from benchmark.camera.spec import PACKAGE_DATA_DIR, CameraSpec
+from benchmark.camera.spec_files import SPEC_DIR_CONTEXT
 from benchmark.suggest import did_you_mean
 
 DATA_DIR = PACKAGE_DATA_DIR

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmark.camera.spec import SensorSpec, read_qe_table
+from benchmark.camera.spec_files import read_qe_table
+from benchmark.camera.spec_sensor import SensorSpec
 from metricscenes.spectral import BAND_WIDTH_NM, WAVELENGTHS_NM, photon_energy_j, resample_spectrum
 
 @dataclass(frozen=True)
@@ -49,7 +50,7 @@ class NoiseOptions:
 @functools.lru_cache(maxsize=16)
 def _read_qe_table(path: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """(wavelengths nm, {"r", "g", "b", "c": QE × IR-cut}) of a QE file, refused in one line
-    unless it is physically possible (:func:`benchmark.camera.spec.read_qe_table`). The clear
+    unless it is physically possible (:func:`benchmark.camera.spec_files.read_qe_table`). The clear
     pixel's QE is the table's ``qe_c`` where it has one, else the sum of its R, G and B curves
     (at most 1): the photodiode without a colour filter collects what the three filters pass
     between them (docs/camera.md, "Clear-pixel colour filters")."""

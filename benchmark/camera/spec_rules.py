@@ -1,11 +1,14 @@
 """The rules every part of a camera spec follows: frozen, no unknown keys
 (:class:`SpecModel`), one serialisation rule for fields added later (:func:`added_later`:
 left out of the JSON, hence of the sha256, at their default), and the plausible ranges of
-fields whose unit is easy to get wrong (:data:`PLAUSIBLE`, :func:`check_plausible`).
+fields whose unit is easy to get wrong (:data:`PLAUSIBLE`: :func:`check_plausible` refuses
+what no sensor has, :func:`plausibility_warnings` names what is possible but unusual).
 
-Kept apart from :mod:`benchmark.camera.spec` so that the specs of each stage (the sensor's
-HDR readout, :mod:`benchmark.camera.spec_readout`) can follow them without importing the
-whole camera spec (docs/camera.md, "Adding a camera feature", "Plausible values").
+Kept apart from :mod:`benchmark.camera.spec` so that the specs of each stage
+(:mod:`~benchmark.camera.spec_optics`, :mod:`~benchmark.camera.spec_sensor` and its HDR readout
+:mod:`~benchmark.camera.spec_readout`, :mod:`~benchmark.camera.spec_exposure`,
+:mod:`~benchmark.camera.spec_isp`) can follow them without importing the whole camera spec
+(docs/camera.md, "Adding a camera feature", "Plausible values").
 """
 
 from __future__ import annotations
@@ -82,6 +85,20 @@ def check_plausible(field: str, value):
     raise ValueError(f"{rule.what} of {_number(value)}{_unit(rule.unit)} is {side} the plausible range "
                      f"{_number(lo)} to {_number(hi)}{_unit(rule.unit)} of real sensors{hint} "
                      "(docs/camera.md, \"Plausible values\")")
+
+
+def plausibility_warnings(camera) -> list[str]:
+    """One line per field of ``camera`` (a :class:`~benchmark.camera.spec.CameraSpec`) whose
+    value is possible but unusual (outside ``usual``)."""
+    out = []
+    for field, rule in PLAUSIBLE.items():
+        section, name = field.split(".")
+        value = getattr(getattr(camera, section), name)
+        lo, hi = rule.usual
+        if not lo <= value <= hi:
+            out.append(f"{field} {_number(value)}{_unit(rule.unit)} is unusual (most sensors: {_number(lo)} to "
+                       f"{_number(hi)}{_unit(rule.unit)}): check its unit")
+    return out
 
 
 ADDED_LATER = "added_later"

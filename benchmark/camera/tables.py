@@ -1,4 +1,4 @@
-"""Numeric CSV tables of user data — a sensor's QE (:func:`benchmark.camera.spec.check_qe_table`),
+"""Numeric CSV tables of user data — a sensor's QE (:func:`benchmark.camera.spec_files.check_qe_table`),
 a lens's PSF or MTF (:mod:`benchmark.camera.lens`) — read with one-line refusals that name
 the file, the row and the column."""
 

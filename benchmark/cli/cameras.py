@@ -137,7 +137,7 @@ def mtf_command(
         "and MTF50 rule on its 21° edge)."),
 ) -> None:
     """Measure MTF50 (ISO 12233 e-SFR through optics + sensor + demosaic)."""
-    from benchmark.camera.spec import isp_preset
+    from benchmark.camera.spec_isp import isp_preset
     from benchmark.measure.mtf import measure_mtf50, mtf50_analytic_cy_per_mm, mtf_readings
 
     cams = _load(names or [])

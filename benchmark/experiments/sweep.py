@@ -61,7 +61,7 @@ from benchmark.scoring.od50 import od50_censoring
 from metricscenes.manifest import parse_illuminance_condition
 
 if TYPE_CHECKING:
-    from benchmark.camera.spec import ExposureSpec
+    from benchmark.camera.spec_exposure import ExposureSpec
 
 # od50.csv's censored: "" (AP crosses 0.5 inside the measured distances), ">" (not yet at the farthest: od50_m is an
 # extrapolation, report "> farthest m") or "<" (below 0.5 already at the nearest); see benchmark.scoring.od50

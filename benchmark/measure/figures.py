@@ -17,7 +17,9 @@ from __future__ import annotations
 import math
 
 from benchmark.camera.exposure import reference_exposure_s
-from benchmark.camera.spec import MAX_CAPTURE_GIB, CameraSpec, plausibility_warnings
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_rules import plausibility_warnings
+from benchmark.camera.spec_sensor import MAX_CAPTURE_GIB
 
 REFERENCE_ILLUMINANCE_LUX = 100.0
 """Illuminance of the SNR reference: a 18 % grey Lambertian surface lit by 100 lux of D65."""

@@ -36,7 +36,9 @@ from benchmark.camera.acquisition import acquire
 from benchmark.camera.calibration import calibrate, illuminant_spectrum
 from benchmark.camera.lens import lens_otf
 from benchmark.camera.pipeline import camera_extent, electron_rate
-from benchmark.camera.spec import CameraSpec, OpticsSpec, SensorSpec
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_optics import OpticsSpec
+from benchmark.camera.spec_sensor import SensorSpec
 from benchmark.measure.targets import slanted_edge_scene
 from metricscenes.spectral import WAVELENGTHS_NM
 

@@ -32,7 +32,8 @@ import numpy as np
 
 from benchmark.camera import dual_gain as _dual_gain
 from benchmark.camera.acquisition import acquire
-from benchmark.camera.spec import CameraSpec, ExposureSpec
+from benchmark.camera.spec import CameraSpec
+from benchmark.camera.spec_exposure import ExposureSpec
 
 PATCH_PX = (32, 64)
 """Rows × columns of one flat-field level (an even number of rows: every CFA site)."""

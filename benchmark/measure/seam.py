@@ -37,7 +37,7 @@ def seam_check(collection: Collection, scene_id: str, condition: str, camera, in
     composite over the plate's (1: as sharp as the plate)."""
     from benchmark.camera.exposure import with_exposure
     from benchmark.camera.pipeline import sensor_extent, simulate
-    from benchmark.camera.spec import ExposureSpec
+    from benchmark.camera.spec_exposure import ExposureSpec
     from metricscenes.radiance import SpectralScene, _overlap_matrix, car_sharpness
 
     if camera.optics.distortion is not None:

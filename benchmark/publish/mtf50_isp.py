@@ -36,7 +36,7 @@ def isetcam_curve(pixel_um: float, f_number: float) -> float:
 
 def mtf50_isp_table(cameras) -> pd.DataFrame:
     """A row per camera (CameraSpecs with a published MTF50 group)."""
-    from benchmark.camera.spec import isp_preset
+    from benchmark.camera.spec_isp import isp_preset
     from benchmark.measure.mtf import measure_mtf50, mtf50_analytic_cy_per_mm
 
     for cam in cameras:  # before measuring any
