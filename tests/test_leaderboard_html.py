@@ -134,4 +134,4 @@ def test_committed_table_fits_1400_px_without_scrolling_sideways(chromium_works,
     widths = json.loads(found.group(1))
     assert widths["page"][0] <= widths["page"][1], widths
     assert widths["tables"] and all(scroll <= client for scroll, client in widths["tables"]), widths
-    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text and "Night AP range (m)" in text
+    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text and "0.1–1 lux image plane, sky raised AP range (m)" in text

@@ -301,7 +301,7 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     row = next(line for line in lines if "cam01-yolov5n-smoke" in line)
     header = next(line for line in lines if line.startswith("| # |"))
     cells = dict(zip([c.strip() for c in header.strip("|").split("|")], [c.strip() for c in row.strip("|").split("|")]))
-    assert cells["#"] == "1" and cells["Camera"] == "cam01" and cells["Day OD50 (m)"].split(" ±")[0] == expected
+    assert cells["#"] == "1" and cells["Camera"] == "cam01" and cells["Daylight OD50 (m)"].split(" ±")[0] == expected
     html = (lb / "index.html").read_text()
     assert 'href="submissions/cam01-yolov5n-smoke.json"' in html and f">{expected}" in html
     assert math.isclose(float(cells["Pixel (µm)"]), 4.2) and math.isclose(float(cells["f-number"]), 3.1)

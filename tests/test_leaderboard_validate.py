@@ -480,7 +480,7 @@ def _laughs(levels: int) -> str:
 @pytest.mark.parametrize(("text", "expected"), [
     (_laughs(6), "invalid protocols file (an alias (*name): a protocols file holds none at line 3)"),
     (PROTOCOLS.format(sha="0" * 64) + "accepted_by: me\n",
-     "invalid protocols file (unknown top-level key(s) accepted_by (it holds only 'protocols'))"),
+     "invalid protocols file (unknown top-level key(s) accepted_by (it holds only 'labels', 'protocols'))"),
     (PROTOCOLS.format(sha="0" * 64).replace("n_environments", "n_environment"),
      "invalid protocols file (protocol 'smoke': unknown key(s) n_environment"),
     (PROTOCOLS.format(sha="0" * 64).replace("description: smoke", "description: [a, b]"),

@@ -16,6 +16,7 @@ from benchmark.cli.publish import app as publish_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
+from benchmark.leaderboard.protocols import condition_label
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.detectability import FOUND_IOU, FOUND_SCORE
 from benchmark.suggest import did_you_mean
@@ -124,7 +125,7 @@ def run(
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     except OSError as exc:  # a full disk, an unwritable folder: nothing written (run_camera stages)
         fail(cannot_write(out, exc))
-    title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
+    title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition_label(condition)} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
     table = Table(title=title, caption=WORKING_POINT_CAPTION)
@@ -244,12 +245,12 @@ def sweep(
     table.add_column("camera")
     table.add_column("MTF50 (cy/mm)", justify="right", no_wrap=True)
     table.add_column("cy/mrad (f)", justify="right", no_wrap=True)
-    for condition in conds:
-        table.add_column(condition, justify="right")
+    for condition in conds:  # named by what it physically is (protocols.yaml labels)
+        table.add_column(condition_label(condition), justify="right")
     ranges = Table(title="AP range ± SD (m): area under AP vs distance, defined where OD50 is censored (docs/scoring.md)")
     ranges.add_column("camera")
     for condition in conds:
-        ranges.add_column(condition, justify="right")
+        ranges.add_column(condition_label(condition), justify="right")
     for camera_name, rows in od50_table.groupby("camera", sort=False):
         by_condition = rows.set_index("condition")
         cells = [sweep_module.od50_cell(by_condition.loc[condition]) for condition in conds]

@@ -35,7 +35,8 @@ score 0.02). A difference at a distance is *called* only when its 95 % interval 
 :data:`FOUND_SCORE` overlapping the car's box at IoU ≥ :data:`FOUND_IOU`
 (:func:`benchmark.scoring.detection_rates`, ``benchmark score``'s working point). Where
 neither camera finds that many, both are *blind* there, and the verdict says so ("both
-blind at night beyond 25 m") instead of calling a difference (docs/scoring.md).
+blind beyond 25 m") instead of calling a difference (docs/scoring.md). The verdict opens with what
+the condition physically is (:func:`benchmark.leaderboard.protocols.condition_label`).
 """
 
 from __future__ import annotations
@@ -59,7 +60,6 @@ from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, perc
 from benchmark.suggest import did_you_mean
 
 COMPARE_FORMAT = "metricscenes-compare/1"
-CONDITION_WORDS = {"day": "by day", "night": "at night", "dusk": "at dusk"}
 MIN_FOUND_CARS = 3
 """Fewest cars the camera with the higher AP must have found at a distance for a difference there to be called."""
 MIN_FOUND_FRACTION = 0.2
@@ -314,10 +314,20 @@ def _rate(x: float | None) -> str:
     return "–" if x is None else f"{x:.2f}"
 
 
-def _when(cond_a: str, cond_b: str) -> tuple[str, str]:
-    if cond_a == cond_b:
-        return CONDITION_WORDS.get(cond_a, f"in {cond_a}" if cond_a else ""), ""
-    return "", f" ({cond_a} vs {cond_b})"
+def _suffix(cond_a: str, cond_b: str) -> str:
+    """" (label A vs label B)" for two conditions, "" for one (the verdict opens with its label:
+    :func:`_condition_prefix`); labels from :func:`benchmark.leaderboard.protocols.condition_label`."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    return "" if cond_a == cond_b else f" ({condition_label(cond_a)} vs {condition_label(cond_b)})"
+
+
+def _condition_prefix(result: dict) -> str:
+    """"daylight: " where both runs share a condition (what it physically is), else ""."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    cond = result["a"]["condition"]
+    return f"{condition_label(cond)}: " if cond and cond == result["b"]["condition"] else ""
 
 
 def _interval_excludes_zero(row: dict) -> bool:
@@ -342,8 +352,8 @@ def blind_from(result: dict) -> float | None:
     return start
 
 
-def _blind_text(result: dict, when: str) -> str:
-    """"; both blind at night beyond 25 m (at every distance beyond it, neither camera found 3
+def _blind_text(result: dict) -> str:
+    """"; both blind beyond 25 m (at every distance beyond it, neither camera found 3
     of the 10 cars ...)", or "" (blind at every distance: :func:`verdict` says it alone)."""
     start = blind_from(result)
     if start is None:
@@ -351,7 +361,7 @@ def _blind_text(result: dict, when: str) -> str:
     rows = sorted(result["per_distance"], key=lambda r: r["distance_m"])
     before = [r["distance_m"] for r in rows if r["distance_m"] < start]
     row = next(r for r in rows if r["distance_m"] == start)
-    return f"; both blind{when} beyond {before[-1]:g} m (at every distance beyond it, {_found_rule_text(result, row)})"
+    return f"; both blind beyond {before[-1]:g} m (at every distance beyond it, {_found_rule_text(result, row)})"
 
 
 def _found_rule_text(result: dict, row: dict) -> str:
@@ -376,20 +386,20 @@ def _unbacked_text(result: dict) -> str:
 
 
 def verdict(result: dict) -> str:
-    """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)",
-    "... AP differs at 50 m ...", or "both blind at night beyond 25 m" (see the module docstring)."""
+    """The plain-language line: "daylight: A detects cars 18 ± 7 m farther than B (95 %: 5–31 m)",
+    "... AP differs at 50 m ...", or "...: both blind beyond 25 m", opening with what the
+    condition physically is (see the module docstring)."""
     if result.get("sample_too_small"):
         return sample_too_small_text(result["environments_per_distance"])
     a, b = result["a"], result["b"]
-    when, _ = _when(a["condition"], b["condition"])
-    when = f" {when}" if when else ""
+    prefix = _condition_prefix(result)
     rows = result["per_distance"]
     if rows and blind_from(result) == min(r["distance_m"] for r in rows):
         first = min(rows, key=lambda r: r["distance_m"])
         last = max(r["distance_m"] for r in rows)
-        return (f"{a['label']} and {b['label']} are both blind{when} at every measured distance "
+        return (f"{prefix}{a['label']} and {b['label']} are both blind at every measured distance "
                 f"({first['distance_m']:g} to {last:g} m: {_found_rule_text(result, first)}): no difference is called")
-    return _od50_verdict(result) + _unbacked_text(result) + _blind_text(result, when) + _too_few_text(result)
+    return prefix + _od50_verdict(result) + _unbacked_text(result) + _blind_text(result) + _too_few_text(result)
 
 
 def _too_few_text(result: dict) -> str:
@@ -404,8 +414,7 @@ def _too_few_text(result: dict) -> str:
 
 def _od50_verdict(result: dict) -> str:
     a, b, od = result["a"], result["b"], result["delta_od50"]
-    when, suffix = _when(a["condition"], b["condition"])
-    when = f" {when}" if when else ""
+    suffix = _suffix(a["condition"], b["condition"])
     pct = f"{100 * result['confidence_level']:g} %"
     if od["delta_m"] is None:
         resolved = [r for r in result["per_distance"] if _resolved(r)]
@@ -415,23 +424,23 @@ def _od50_verdict(result: dict) -> str:
         tail = (f"AP differs at {where} m"
                 if resolved else "no AP difference resolved at any distance")
         if result.get("delta_ap_range") is not None:
-            return _range_verdict(result, od_a, od_b, when + suffix, tail, pct)
+            return _range_verdict(result, od_a, od_b, suffix, tail, pct)
         for first, second in ((a, b), (b, a)):  # a lower bound beats a measured value below it
             if first["censored"] == ">" and not second["censored"] and second["od50_m"] is not None:
                 gap = first["bound_m"] - second["od50_m"]
-                return (f"{first['label']} detects cars farther than {second['label']}{when}{suffix}, by at least "
+                return (f"{first['label']} detects cars farther than {second['label']}{suffix}, by at least "
                         f"{gap:.0f} m (OD50 {format_od50(None, '>', first['bound_m'])} vs {second['od50_m']:.1f} m; "
                         f"a bound, not a measured difference); {tail} ({pct})")
-        return (f"OD50 of {a['label']} is {od_a} and of {b['label']} {od_b}{when}{suffix}: outside the measured distances, "
+        return (f"OD50 of {a['label']} is {od_a} and of {b['label']} {od_b}{suffix}: outside the measured distances, "
                 f"ΔOD50 is not measured; {tail} ({pct})")
     d, sd, (lo, hi) = od["delta_m"], od["sd_m"] or 0.0, od["ci95_m"]
     if not (lo > 0 or hi < 0):
-        return (f"no difference resolved between {a['label']} and {b['label']}{when}{suffix}: "
+        return (f"no difference resolved between {a['label']} and {b['label']}{suffix}: "
                 f"ΔOD50 = {d:+.0f} ± {sd:.0f} m ({pct}: {lo:.0f} to {hi:.0f} m)")
     word, first, second = ("farther", a, b) if d > 0 else ("farther", b, a)
     if d < 0:
         lo, hi = -hi, -lo
-    return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{when}{suffix} "
+    return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{suffix} "
             f"({pct}: {lo:.0f}–{hi:.0f} m)")
 
 

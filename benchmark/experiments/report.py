@@ -13,6 +13,9 @@ car detection (red, with its score). Every image is embedded as base64 PNG and t
 page loads nothing from elsewhere; the figures are also written as PNG and SVG next
 to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
 
+Conditions are named by what they physically are
+(:func:`benchmark.leaderboard.protocols.condition_label`) in titles, tables and headings.
+
 Where the cameras differ in focal length the MTF50 axis of the figures is the angular one
 (cycles/mrad in object space, :func:`benchmark.experiments.spm.mtf50_axis`); the captions say
 which axis each figure uses.
@@ -203,7 +206,7 @@ def plot_ap_curves(table: pd.DataFrame, out=None, *, axis: str = "sensor"):
         sns.lineplot(data=data[data["condition"] == condition], x="distance_m", y="ap", hue="camera",
                      hue_order=list(labels.values()), palette=palette, marker="o", ax=ax, legend=ax is axes[0][-1])
         ax.axhline(0.5, color="grey", lw=0.8, ls=":")
-        ax.set(title=condition, xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)", ylim=(-0.02, 1.02))
+        ax.set(title=_label(condition), xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)", ylim=(-0.02, 1.02))
     legend = axes[0][-1].get_legend()
     if legend is not None:
         sns.move_legend(axes[0][-1], "upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7, title="camera (MTF50)")
@@ -238,7 +241,8 @@ def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
         "AP range 95 % (m)": [_interval(_num(lo), _num(hi)) for lo, hi in zip(
             _col(rows, "ap_range_ci95_lo_m", np.nan), _col(rows, "ap_range_ci95_hi_m", np.nan))],
     }, index=rows.index)
-    return out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+    out = out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+    return out.assign(condition=out["condition"].map(_label))
 
 
 def working_point_table(runs: dict[tuple[str, str], Path]) -> pd.DataFrame | None:
@@ -249,7 +253,7 @@ def working_point_table(runs: dict[tuple[str, str], Path]) -> pd.DataFrame | Non
     for (camera, condition), folder in runs.items():
         per = _working_point(Path(folder))
         if per:
-            rows.append({"camera": camera, "condition": condition,
+            rows.append({"camera": camera, "condition": _label(condition),
                          **{f"{d:g} m": f"{m:.2f} / {fp:.2f}" for d, (m, fp) in sorted(per.items())}})
     return pd.DataFrame(rows).fillna("–") if rows else None
 
@@ -326,6 +330,13 @@ def image_strips(runs: dict[tuple[str, str], Path], table: pd.DataFrame) -> list
     return [{"distance_m": d, "condition": c, "images": v} for (d, c), v in sorted(strips.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], 99)))]
 
 
+def _label(condition: str) -> str:
+    """What a condition physically is (:func:`benchmark.leaderboard.protocols.condition_label`)."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    return condition_label(condition)
+
+
 def report(results_dir, out=None) -> Path:
     """Write ``report.html`` and its figures; returns the page's path. ``results_dir``: a
     sweep or run folder (the page goes there by default), or a list of them (:func:`load_many`;
@@ -373,7 +384,7 @@ def report(results_dir, out=None) -> Path:
                         "<span style='color:#e00'>red</span>: best car detection and its score.</p>")
         for s in strips:
             cells = "".join(_thumb_html(i) for i in s["images"])
-            sections.append(f"<h3>{s['distance_m']:g} m · {html.escape(s['condition'])}</h3><div class='strip'>{cells}</div>")
+            sections.append(f"<h3>{s['distance_m']:g} m · {html.escape(_label(s['condition']))}</h3><div class='strip'>{cells}</div>")
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(_page(meta, "\n".join(sections)), encoding="utf-8")
     summary.to_csv(out.parent / "report_table.csv", index=False)
