@@ -1,5 +1,5 @@
 """The protocols a leaderboard accepts: manifest hashes, distances, conditions and environments;
-and what each condition physically is (its label).
+which submissions are its references; and what each condition physically is (its label).
 
 Packaged in ``data/protocols.yaml``; a leaderboard folder may carry its own
 ``protocols.yaml`` (same format), which then replaces the packaged one, so a maintainer
@@ -16,6 +16,7 @@ none is given). A leaderboard's own file without ``labels`` keeps the packaged o
 
 from __future__ import annotations
 
+import fnmatch
 from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import resources
@@ -29,7 +30,7 @@ from metricscenes.manifest import UniqueKeyLoader
 PROTOCOLS_FILE = "protocols.yaml"
 MAX_PROTOCOLS_BYTES = 1 << 20
 PROTOCOL_KEYS = ("description", "manifests_sha256", "distances_m", "conditions", "required_conditions",
-                 "n_environments", "collection_names")
+                 "n_environments", "collection_names", "references", "made_before_detections")
 TOP_KEYS = ("labels", "protocols")
 MAX_LABEL_CHARS = 80  # a column header, a figure title
 
@@ -46,6 +47,9 @@ class Protocol:
     required_conditions: tuple[str, ...]
     n_environments: int | None = None  # environments of the collection; None: not checked
     collection_names: tuple[str, ...] = ()  # the names its manifests give their collections; () : the protocol's name
+    references: str | None = None  # glob of its reference submissions' names (the band they draw); None: none
+    # submissions made before detections shipped, accepted without them: name -> sha256 of the canonical JSON
+    made_before_detections: dict[str, str] = field(default_factory=dict, hash=False)
     labels: dict[str, str] = field(default_factory=dict, hash=False, compare=False)  # condition -> what it is
 
     def __post_init__(self):
@@ -55,6 +59,10 @@ class Protocol:
     def label(self, condition: str) -> str:
         """What ``condition`` physically is (:func:`condition_label` with this file's labels)."""
         return condition_label(condition, self.labels)
+
+    def is_reference(self, name: str) -> bool:
+        """Whether a submission of this protocol named ``name`` is one of its references."""
+        return self.references is not None and fnmatch.fnmatchcase(name, self.references)
 
 
 class _PlainLoader(UniqueKeyLoader):
@@ -95,6 +103,13 @@ def _label_text(value, what: str) -> str:
     return text
 
 
+def _sha256_text(value, what: str) -> str:
+    text = _text(value, what)
+    if len(text) != 64 or any(c not in "0123456789abcdef" for c in text):
+        raise ValueError(f"{what} must be a sha256 (64 lowercase hex digits)")
+    return text
+
+
 def _count(value) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ValueError(f"n_environments must be a positive integer, got {value!r}")
@@ -127,6 +142,9 @@ def _parse(text: str, source: str, default_labels: dict[str, str] | None = None)
                 required_conditions=_texts(p["required_conditions"], f"protocol {name!r}: required_conditions"),
                 n_environments=None if p.get("n_environments") is None else _count(p["n_environments"]),
                 collection_names=_texts(p.get("collection_names", []), f"protocol {name!r}: collection_names"),
+                references=None if p.get("references") is None else _text(p["references"], f"protocol {name!r}: references"),
+                made_before_detections=_mapping(p.get("made_before_detections", {}),
+                                                f"protocol {name!r}: made_before_detections", _sha256_text),
                 labels=labels,
             )
     except yaml.MarkedYAMLError as exc:
