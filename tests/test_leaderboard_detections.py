@@ -1,6 +1,7 @@
 """Submissions ship their detections: `submit` writes them, `submit --check` recomputes every AP from
 them and refuses an edited AP, a corrupted file or a new submission without them (the references
-made before detections shipped are accepted with a warning); condition labels come from protocols.yaml."""
+made before detections shipped are accepted with a warning); `compare --reference` pairs a run with
+a submission by scene, and `report --references` draws a run over the references' band."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import gzip
 import hashlib
 import json
 import math
+import os
 import shutil
 from pathlib import Path
 
@@ -222,6 +224,160 @@ def test_a_reference_made_before_detections_shipped_is_accepted_with_its_warning
     assert res.exit_code == 2 and stderr.strip().splitlines() == [
         "error: ref-cam12-yolov5n-quick.json: carries no detections: its AP cannot be recomputed (and it is not the file "
         "pinned as made before detections shipped: edited?); `benchmark submit` writes them beside the file"], stderr
+
+
+# ── compare with a reference ────────────────────────────────────────────────────────────────
+
+def test_compare_with_a_reference_pairs_it_by_scene(board, runs):
+    """A run against a submission's shipped detections is the comparison with the run it was
+    made from: the same AP, ΔAP, intervals and verdict, B named by the submission."""
+    from benchmark.experiments.compare import compare_paths
+
+    mine = runs / "runs" / "cam07-day"
+    by_reference = compare_paths(mine, reference="ref-cam03", leaderboard_dir=board, n_resamples=100)
+    by_run = compare_paths(mine, runs / "runs" / "cam03-day", n_resamples=100)
+    assert by_reference["b"]["label"] == "ref-cam03" and by_run["b"]["label"] == "cam03"
+    assert by_reference["per_distance"] == by_run["per_distance"]
+    assert by_reference["delta_ap_range"] == by_run["delta_ap_range"] and by_reference["delta_od50"] == by_run["delta_od50"]
+    assert by_reference["verdict"] == by_run["verdict"].replace("cam03", "ref-cam03")
+    path = compare_paths(mine, reference=board / "submissions" / "ref-cam03.json", n_resamples=100)  # or a path
+    assert path["per_distance"] == by_run["per_distance"]
+
+
+def test_compare_with_a_reference_from_the_cli_and_its_refusals(board, runs, tmp_path):
+    from benchmark.cli.main import app as main_app
+
+    def compare(*args):
+        res = CliRunner().invoke(main_app, ["compare", *map(str, args), "--resamples", "50"])
+        return res, (getattr(res, "stderr", None) or res.output)
+
+    mine = runs / "runs" / "cam07-day"
+    res, _ = compare(mine, "--reference", "ref-cam03", "--leaderboard", board)
+    assert res.exit_code == 0, res.output
+    assert "cam07 − ref-cam03" in " ".join(res.output.split())  # (4 environments: no verdict, the table all the same)
+    for args, expected in (
+        ((mine, "--reference", "ref-cam12-yolov5n-quick", "--leaderboard", COMMITTED),
+         "error: ref-cam12-yolov5n-quick carries no detections (made before detections shipped): it cannot be paired by scene"),
+        ((runs / "runs" / "cam03-night", "--reference", "ref-cam07", "--leaderboard", board),
+         "error: ref-cam07 has no condition 'night' (it has: day)"),
+        ((mine, runs / "runs" / "cam03-day", "--reference", "ref-cam03", "--leaderboard", board),
+         "error: give B (a run or sweep folder) or --reference"),
+        ((mine, "--reference", "ref-cam3", "--leaderboard", board), "error: --reference ref-cam3: no such submission ("),
+    ):
+        res, stderr = compare(*args)
+        assert res.exit_code == 2 and len(stderr.strip().splitlines()) == 1 and stderr.startswith(expected), stderr
+    lb = _copy(board, tmp_path)
+    _flip_a_byte(lb)
+    res, stderr = compare(mine, "--reference", "ref-cam03", "--leaderboard", lb)
+    assert res.exit_code == 2 and "ref-cam03.detections/day.json.gz: sha256" in stderr, stderr
+
+
+@pytest.mark.slow
+def test_a_smoke_run_compared_with_a_submission_that_ships_its_detections(smoke_collection, tmp_path):
+    """Two cameras run on the smoke collection; one is submitted (with its detections) and --check
+    recomputes its AP; the other compared with that submission is its comparison with the run."""
+    model_dir = Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
+    if not (model_dir / "yolov5n-dynamic.onnx").is_file():
+        pytest.skip(f"yolov5n-dynamic.onnx not found in METRICSCENES_MODEL_DIR={model_dir}")
+    from benchmark.camera import load_camera
+    from benchmark.detectors import load_detector
+    from benchmark.experiments.compare import compare_paths
+    from benchmark.experiments.run import run_camera
+    from metricscenes.store import Collection
+
+    collection = Collection.open(smoke_collection)
+    detector = load_detector("yolov5n-dynamic", model_dir=model_dir)
+    for cam in ("cam01", "cam12"):
+        run_camera(collection, load_camera(cam), "day", detector, tmp_path / f"run-{cam}", save_images=False)
+    lb = tmp_path / "leaderboard"  # the packaged protocols accept the smoke manifest
+    res, _ = _invoke(leaderboard_app(), ["submit", tmp_path / "run-cam12", "--name", "cam12-smoke", "--submitter", "tests",
+                                         "--leaderboard", lb, "--n-resamples", "50", "--created-at", CREATED])
+    assert res.exit_code == 0, res.output
+    res, _ = _invoke(leaderboard_app(), ["submit", "--check", lb / "submissions" / "cam12-smoke.json", "--leaderboard", lb])
+    assert res.exit_code == 0 and "AP recomputed from its shipped detections (1 condition(s))" in res.output, res.output
+    by_reference = compare_paths(tmp_path / "run-cam01", reference="cam12-smoke", leaderboard_dir=lb, n_resamples=100)
+    by_run = compare_paths(tmp_path / "run-cam01", tmp_path / "run-cam12", n_resamples=100)
+    assert by_reference["per_distance"] == by_run["per_distance"] and by_reference["b"]["label"] == "cam12-smoke"
+
+
+# ── the references' band ────────────────────────────────────────────────────────────────────
+
+def test_the_band_of_the_committed_references():
+    """Lowest, median and highest AP per distance of the 13 committed references of each protocol,
+    from their submitted AP alone (they ship no detections), drawn as the page's SVG."""
+    import statistics
+
+    from benchmark.leaderboard import load_submissions
+    from benchmark.leaderboard.band import band_svg, reference_band
+
+    protocols = load_protocols(COMMITTED)
+    subs = load_submissions(COMMITTED, protocols)
+    for name in ("quick", "metric-300"):
+        protocol = protocols[name]
+        band = reference_band(subs, protocol)
+        assert [b.condition for b in band] == ["day", "dusk", "night", "night_regulation"] and {b.n for b in band} == {13}
+        files = sorted((COMMITTED / "submissions").glob(f"ref-cam*-yolov5n-{name}.json"))
+        assert len(files) == 13
+        for b in band:
+            curves = [{r["distance_m"]: r["ap"] for r in json.loads(f.read_text())["conditions"][b.condition]["per_distance"]}
+                      for f in files]
+            assert b.distances_m == protocol.distances_m
+            for k, d in enumerate(b.distances_m):
+                values = [c[d] for c in curves]
+                assert (b.lo[k], b.median[k], b.hi[k]) == (min(values), statistics.median(values), max(values))
+        svg = band_svg(band, protocol)
+        assert svg == band_svg(band, protocol) and svg.count("<polygon") == 4 and 'style="' not in svg
+        for b in band:
+            assert f">{protocol.label(b.condition)}</text>" in svg
+
+
+def _quick_stand_in():
+    """The quick manifest the committed references were made on, as write_synthetic_run reads a manifest."""
+    from metricscenes.manifest import load_manifest
+
+    quick = load_manifest(REPO / "manifests" / "quick.yaml")
+    sha = json.loads((COMMITTED / "submissions" / "ref-cam12-yolov5n-quick.json").read_text())["collection"]["manifest_sha256"]
+
+    class StandIn:
+        name, protocol, distances_m = quick.name, quick.protocol, quick.distances_m
+
+        @staticmethod
+        def sha256():
+            return sha
+
+    return StandIn()
+
+
+def test_report_draws_a_run_over_the_references_band(tmp_path, runs):
+    """One command, one figure: a run of the quick collection over the 13 references' band, nothing rendered."""
+    from benchmark.camera import load_camera
+    from benchmark.cli.main import app as main_app
+
+    run = tmp_path / "mine-day"
+    write_synthetic_run(run, load_camera("cam05"), "day", manifest=_quick_stand_in(), n_environments=10, half_range_m=120.0)
+    page = tmp_path / "report" / "mine.html"
+    res = CliRunner().invoke(main_app, ["report", str(run), "--references", "quick", "--leaderboard", str(COMMITTED),
+                                        "--out", str(page)])
+    assert res.exit_code == 0, res.output
+    text = page.read_text()
+    assert "<h2>Beside the references</h2>" in text and "13 reference submissions of quick" in text
+    assert (page.parent / "figures" / "references_quick.png").is_file()
+    # the figure itself: the band's median and the run's curve, in a panel named by what the condition is
+    from benchmark.experiments.report import load_results, plot_over_band
+    from benchmark.leaderboard.band import references_of
+
+    protocol, band = references_of("quick", COMMITTED)
+    table = load_results(run)[0]
+    fig = plot_over_band(table, band, protocol)
+    (ax,) = fig.axes
+    assert ax.get_title() == condition_label("day")
+    median, mine = (line for line in ax.get_lines() if len(line.get_xdata()) == 6)
+    assert list(median.get_ydata()) == list(band[0].median) and list(mine.get_ydata()) == list(table.sort_values("distance_m")["ap"])
+    # a run on another collection has no reference to stand beside
+    res = CliRunner().invoke(main_app, ["report", str(runs / "runs" / "cam07-day"), "--references", "quick", "--leaderboard",
+                                        str(COMMITTED), "--out", str(tmp_path / "other.html")])
+    out = getattr(res, "stderr", None) or res.output
+    assert res.exit_code == 2 and "--references quick: no reference submission (ref-*-yolov5n-quick) on manifest" in out
 
 
 # ── condition labels ────────────────────────────────────────────────────────────────────────

@@ -312,11 +312,12 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
 def test_committed_reference_submissions_are_valid_and_rendered():
     """The reference submissions in leaderboard/ still pass every check against the
     packaged protocols (a manifest change must come with new references; made before detections
-    shipped, each is accepted with its warning), and the committed table is what `benchmark
-    leaderboard` renders from them."""
+    shipped, each is accepted with its warning), and the committed table and band figures are
+    what `benchmark leaderboard` renders from them."""
     from benchmark.leaderboard import (
         NoDetectionsWarning, check_submission_file, load_protocols, load_submissions, render_html, render_markdown,
     )
+    from benchmark.leaderboard.render import band_figures
 
     folder = REPO / "leaderboard"
     subs = sorted((folder / "submissions").glob("*.json"))
@@ -329,6 +330,10 @@ def test_committed_reference_submissions_are_valid_and_rendered():
     submissions = load_submissions(folder, protocols)
     assert render_markdown(submissions, protocols) == (folder / "README.md").read_text()
     assert render_html(submissions, protocols) == (folder / "index.html").read_text()
+    figures = band_figures(submissions, protocols)
+    assert sorted(figures) == ["metric-300", "quick"]
+    for name, svg in figures.items():
+        assert (folder / f"references-{name}.svg").read_text() == svg
 
 
 def test_tree_hash_of_a_missing_folder_is_empty(tmp_path):

@@ -276,9 +276,12 @@ def report(
         metavar="RESULTS_DIR")],
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help=(
         "HTML page (default RESULTS_DIR/report.html for one folder; required for several)"))] = None,
+    references: Annotated[Optional[str], typer.Option(help=(
+        "a leaderboard protocol (quick, metric-300): draw the runs' AP vs distance over its reference submissions' band"))] = None,
+    leaderboard: Annotated[Path, typer.Option("--leaderboard", help="leaderboard folder --references reads")] = Path("leaderboard"),
 ) -> None:
     """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips (of one folder, or of
-    several run and sweep folders side by side)."""
+    several run and sweep folders side by side); with --references, the runs over the references' band."""
     from benchmark.experiments.report import report as write_report
     from metricscenes.outputs import RUN, SWEEP, check_output, folder_kind
 
@@ -295,7 +298,8 @@ def report(
     try:  # the page, figures/ and report_table.csv: in RESULTS_DIR, or outside every collection, run and leaderboard
         check_output(out if out is not None else results_dirs[0] / "report.html", "--out", given=given)
         with err.status("writing the report"):
-            page = write_report(results_dirs if len(results_dirs) > 1 else results_dirs[0], out)
+            page = write_report(results_dirs if len(results_dirs) > 1 else results_dirs[0], out, references=references,
+                                leaderboard_dir=leaderboard)
     except (ValueError, OSError, KeyError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     console.print(f"wrote {page} (figures in {page.parent / 'figures'})")

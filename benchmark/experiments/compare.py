@@ -101,6 +101,7 @@ class Side(RunFolder):
 
     groundtruth: dict
     detections: list
+    name: str | None = None  # a leaderboard submission's name (a reference side), shown as its label
 
     @property
     def manifest_sha256(self) -> str:
@@ -161,6 +162,53 @@ def load_side(folder: str | Path) -> Side:
         raise CompareError(f"{folder}: unreadable JSON ({exc})") from None
 
 
+def submission_path(reference: str | Path, leaderboard_dir: str | Path = "leaderboard") -> Path:
+    """The submission file of ``reference``: a path to a ``.json``, or a name on the leaderboard
+    (``leaderboard_dir/submissions/<name>.json``)."""
+    reference = str(reference)
+    if reference.endswith(".json") or "/" in reference or "\\" in reference:
+        return Path(reference)
+    return Path(leaderboard_dir) / "submissions" / f"{reference}.json"
+
+
+def load_reference(reference: str | Path, condition: str, leaderboard_dir: str | Path = "leaderboard") -> Side:
+    """One condition of a leaderboard submission as a comparison side, from the detections and
+    ground truth it ships (checksummed: :mod:`benchmark.leaderboard.detections`); refused in one
+    line where it has no such condition or ships no detections (made before they shipped)."""
+    from benchmark.leaderboard.detections import pack_path, read_pack
+    from benchmark.leaderboard.schema import SubmissionError
+    from benchmark.leaderboard.validate import read_submission_file
+    from benchmark.result_files import CameraRecord, CollectionRecord, RunResults
+
+    path = submission_path(reference, leaderboard_dir)
+    if not path.is_file():
+        held = sorted(p.stem for p in path.parent.glob("*.json")) if path.parent.is_dir() else []
+        raise CompareError(f"--reference {reference}: no such submission ({path}){did_you_mean(path.stem, held)}")
+    try:
+        data = read_submission_file(path)
+        if not isinstance(data, dict) or not isinstance(data.get("conditions"), dict):
+            raise SubmissionError(f"{path.name}: not a submission")
+        cond = data["conditions"].get(condition)
+        if not isinstance(cond, dict):
+            raise CompareError(f"{path.stem} has no condition {condition!r} (it has: {', '.join(sorted(data['conditions']))})")
+        digest = cond.get("shipped_detections_sha256")
+        if digest is None:
+            raise CompareError(f"{path.stem} carries no detections (made before detections shipped): it cannot be paired "
+                               "by scene; `benchmark report RUN --references PROTOCOL` draws a run over the references' AP")
+        body = read_pack(pack_path(path, condition), expected_sha256=digest,
+                         source=f"{path.stem}.detections/{condition}.json.gz")
+        results = RunResults(camera=CameraRecord(name=data["camera"]["name"]), condition=condition,
+                             collection=CollectionRecord(**{k: data["collection"][k] for k in ("name", "protocol", "manifest_sha256")}),
+                             scoring_backend=data["scoring"]["backend"])
+    except CompareError:
+        raise
+    except SubmissionError as exc:
+        raise CompareError(str(exc)) from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CompareError(f"{path.name}: not a submission ({type(exc).__name__}: {exc})".splitlines()[0]) from None
+    return Side(path, results, body["groundtruth"], body["detections"], name=data["name"])
+
+
 def check_comparable(a: Side, b: Side) -> None:
     """Raise :class:`CompareError` (one line) unless A and B share collection and scenes."""
     if not a.manifest_sha256 or a.manifest_sha256 != b.manifest_sha256:
@@ -174,6 +222,8 @@ def check_comparable(a: Side, b: Side) -> None:
 
 
 def _label(side: Side, other: Side) -> str:
+    if side.name is not None:
+        return side.name
     if side.camera != other.camera:
         return side.camera
     if side.condition != other.condition:
@@ -493,15 +543,22 @@ def plot_compare(result: dict, out: str | Path) -> Path:
     return out
 
 
-def compare_paths(path_a, path_b, *, cameras=(), condition: str = "day", **kwargs) -> dict:
-    """Resolve A and B (run or sweep folders; ``cameras``: none, one for both, or one each) and compare."""
+def compare_paths(path_a, path_b=None, *, cameras=(), condition: str = "day", reference: str | Path | None = None,
+                  leaderboard_dir: str | Path = "leaderboard", **kwargs) -> dict:
+    """Resolve A and B (run or sweep folders; ``cameras``: none, one for both, or one each) and
+    compare; or A against ``reference``, a leaderboard submission (name or path) under A's condition."""
     cameras = list(cameras)
-    if len(cameras) > 2:
-        raise CompareError(f"--camera: give one (both sides) or two (A then B), got {len(cameras)}")
+    if (path_b is None) == (reference is None):
+        raise CompareError("give B (a run or sweep folder) or --reference (a leaderboard submission), not both")
+    if len(cameras) > (1 if reference is not None else 2):
+        raise CompareError(f"--camera: give one (both sides) or two (A then B), got {len(cameras)}"
+                           if reference is None else "--camera: with --reference give one (A's), or none")
     cam_a = cameras[0] if cameras else None
     cam_b = cameras[-1] if cameras else None
-    return compare_runs(load_side(resolve_run(path_a, cam_a, condition)),
-                        load_side(resolve_run(path_b, cam_b, condition)), **kwargs)
+    a = load_side(resolve_run(path_a, cam_a, condition))
+    b = load_reference(reference, a.condition, leaderboard_dir) if reference is not None else load_side(
+        resolve_run(path_b, cam_b, condition))
+    return compare_runs(a, b, **kwargs)
 
 
 def register(app) -> None:
@@ -514,7 +571,10 @@ def register(app) -> None:
     @app.command()
     def compare(
         a: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
-        b: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
+        b: Annotated[Optional[Path], typer.Argument(help="run folder, or sweep folder with --camera (or --reference)")] = None,
+        reference: Annotated[Optional[str], typer.Option(
+            help="instead of B: a leaderboard submission (name, or path to its .json) that ships its detections")] = None,
+        leaderboard: Annotated[Path, typer.Option("--leaderboard", help="leaderboard folder --reference names are in")] = Path("leaderboard"),
         camera: Annotated[Optional[list[str]], typer.Option(
             help="camera in a sweep folder: once for both sides, twice for A then B")] = None,
         condition: Annotated[str, typer.Option(help="condition of the runs in sweep folders")] = "day",
@@ -522,7 +582,8 @@ def register(app) -> None:
         resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples over environments")] = BOOTSTRAP_RESAMPLES,
         seed: Annotated[int, typer.Option(help="bootstrap seed")] = 0,
     ) -> None:
-        """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict."""
+        """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict; B is a
+        run, or --reference, a leaderboard submission paired scene by scene through the detections it ships."""
         from metricscenes.outputs import OutputError, check_output
 
         console, err = Console(), Console(stderr=True)
@@ -530,7 +591,8 @@ def register(app) -> None:
             if out is not None:  # not into a collection, a run, a sweep or the leaderboard
                 check_output(out, "--out")
             with err.status("paired bootstrap"):
-                result = compare_paths(a, b, cameras=camera or (), condition=condition, n_resamples=resamples, seed=seed)
+                result = compare_paths(a, b, cameras=camera or (), condition=condition, reference=reference,
+                                       leaderboard_dir=leaderboard, n_resamples=resamples, seed=seed)
         except (CompareError, OutputError, ValueError, OSError) as exc:
             fail(str(exc).splitlines()[0])
         ra, rb = result["a"], result["b"]

@@ -13,7 +13,9 @@ car detection (red, with its score). Every image is embedded as base64 PNG and t
 page loads nothing from elsewhere; the figures are also written as PNG and SVG next
 to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
 
-Conditions are named by what they physically are
+``references``: a protocol whose reference submissions' AP per distance (the leaderboard's band,
+:mod:`benchmark.leaderboard.band`) the runs are drawn over, "Beside the references", without
+rendering them. Conditions are named by what they physically are
 (:func:`benchmark.leaderboard.protocols.condition_label`) in titles, tables and headings.
 
 Where the cameras differ in focal length the MTF50 axis of the figures is the angular one
@@ -337,10 +339,53 @@ def _label(condition: str) -> str:
     return condition_label(condition)
 
 
-def report(results_dir, out=None) -> Path:
+def plot_over_band(table: pd.DataFrame, band, protocol, out=None):
+    """The runs' AP vs distance (a line per camera) over the references' band (lowest to highest
+    AP shaded, median dashed), one panel per condition both hold; ``band``:
+    :func:`benchmark.leaderboard.band.reference_band`. ValueError where they share no condition."""
+    bands = [b for b in band if b.condition in set(table["condition"])]
+    if not bands:
+        raise ValueError(f"--references {protocol.name}: its references hold no condition of these runs "
+                         f"(they hold {', '.join(b.condition for b in band)}; the runs {', '.join(dict.fromkeys(table['condition']))})")
+    fig, axes = plt.subplots(1, len(bands), figsize=(4.6 * len(bands) + 1.6, 3.8), squeeze=False, sharey=True,
+                             constrained_layout=True)
+    cameras = list(dict.fromkeys(table["camera"]))
+    for ax, b in zip(axes[0], bands):
+        ax.fill_between(b.distances_m, b.lo, b.hi, color="#9ecae1", alpha=0.7, lw=0,
+                        label=f"{b.n} references: lowest to highest")
+        ax.plot(b.distances_m, b.median, "--", color="#08519c", lw=1.2, label="references: median")
+        part = table[table["condition"] == b.condition]
+        for k, camera in enumerate(cameras):
+            rows = part[part["camera"] == camera].sort_values("distance_m")
+            if not rows.empty:
+                ax.plot(rows["distance_m"], rows["ap"], "o-", color=f"C{(k + 1) % 10}", lw=1.8, label=camera)
+        ax.axhline(0.5, color="grey", lw=0.8, ls=":")
+        ax.set(title=protocol.label(b.condition), xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)",
+               ylim=(-0.02, 1.02))
+    axes[0][-1].legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7)
+    if out is not None:
+        spm.save_figure(fig, out)
+    return fig
+
+
+def _references_figure(table: pd.DataFrame, meta: dict, references: str, leaderboard_dir, fig_dir: Path) -> tuple:
+    from benchmark.leaderboard.band import references_of
+
+    manifest = meta.get("collection", {}).get("manifest_sha256")
+    protocol, band = references_of(references, leaderboard_dir, manifest_sha256=manifest)
+    n = max(b.n for b in band)
+    caption = (f"AP vs distance of these runs over the {n} reference submissions of {protocol.name} "
+               f"({protocol.references}, from {leaderboard_dir}) on the same collection: shaded from their lowest to "
+               "their highest AP, dashed their median (from the AP per distance they submitted; nothing rendered "
+               "again); dotted: AP 0.5.")
+    return ("Beside the references", caption, plot_over_band(table, band, protocol, fig_dir / f"references_{protocol.name}"))
+
+
+def report(results_dir, out=None, *, references: str | None = None, leaderboard_dir="leaderboard") -> Path:
     """Write ``report.html`` and its figures; returns the page's path. ``results_dir``: a
     sweep or run folder (the page goes there by default), or a list of them (:func:`load_many`;
-    ``out`` required)."""
+    ``out`` required). ``references``: a protocol of the leaderboard in ``leaderboard_dir``
+    whose references' band the runs are drawn over (:func:`plot_over_band`)."""
     folders = [Path(p) for p in results_dir] if isinstance(results_dir, (list, tuple)) else [Path(results_dir)]
     if out is None and len(folders) > 1:
         raise ValueError(f"{len(folders)} results folders: name the page with --out (e.g. --out report/report.html)")
@@ -349,7 +394,8 @@ def report(results_dir, out=None) -> Path:
     fig_dir = out.parent / "figures"
     is_lux = table["condition"].map(parse_illuminance_condition).notna()
     main, main_od50 = table[~is_lux], od50[~od50["condition"].map(parse_illuminance_condition).notna()]
-    figures = _main_figures(main, main_od50, fig_dir) if not main.empty else []
+    beside = [_references_figure(main, meta, references, leaderboard_dir, fig_dir)] if references else []
+    figures = beside + (_main_figures(main, main_od50, fig_dir) if not main.empty else [])
     lux = illuminance_table(table)
     for camera, part in lux.groupby("camera", sort=False):
         if part["illuminance_lux"].nunique() >= 2 and part["distance_m"].nunique() >= 2:

@@ -8,7 +8,9 @@ submission's ``created_at``. OD50 and AP range from fewer than
 (:func:`metricscenes.files.write_atomic`) and only after every submission
 has validated, so a bad submission or an interrupted render leaves the old table intact.
 
-Columns name each condition by what it physically is (:meth:`Protocol.label`).
+Columns and figures name each condition by what it physically is (:meth:`Protocol.label`). Under
+each protocol's table the references' band (:mod:`benchmark.leaderboard.band`): inline SVG in the
+page, ``references-<protocol>.svg`` beside README.md.
 
 The HTML page is self-contained: inline CSS and a small vanilla-JS sorter, allowed by a
 Content-Security-Policy that names their sha256 and nothing else (no external URLs).
@@ -27,6 +29,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from benchmark.leaderboard.band import band_svg, reference_band
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.scoring.sample import few_footnote
 from benchmark.leaderboard.validate import SUBMISSIONS, duplicate_problem, read_submission_file, validate_submission
@@ -235,6 +238,32 @@ def _by_protocol(submissions: list[dict], protocols: dict[str, Protocol]) -> lis
     return [(p, ranked([s for s in submissions if s["collection"]["protocol"] == name])) for name, p in protocols.items()]
 
 
+_SAFE_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
+
+
+def band_file(protocol: Protocol) -> str | None:
+    """``references-<protocol>.svg``, the band's file beside README.md (None: a name unfit for a file)."""
+    return f"references-{protocol.name}.svg" if _SAFE_FILE.fullmatch(protocol.name) else None
+
+
+def band_figures(submissions: list[dict], protocols: dict[str, Protocol]) -> dict[str, str]:
+    """{protocol name: SVG of its references' band} for the protocols that have references."""
+    out = {}
+    for name, protocol in protocols.items():
+        band = reference_band(submissions, protocol)
+        if band:
+            out[name] = band_svg(band, protocol)
+    return out
+
+
+def _band_caption(submissions: list[dict], protocol: Protocol) -> tuple[str, str]:
+    """(text, command) under the band figure."""
+    n = sum(1 for s in submissions if s["collection"]["protocol"] == protocol.name and protocol.is_reference(s["name"]))
+    return (f"AP vs distance of the {n} references ({protocol.references}), per condition: shaded from the lowest to "
+            "the highest AP, the line their median; dotted: AP 0.5. A run over it:",
+            f"benchmark report RUN --references {protocol.name}")
+
+
 # Markdown's inline syntax: a backslash before any of these shows it as itself (CommonMark
 # "backslash escapes"), as html.escape does for the page; "|" would end the table cell.
 _MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|~&!#])")
@@ -275,6 +304,7 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
         *([_md(few_footnote()) + ".", ""] if _few(submissions) else []),
         f"{len(submissions)} submission(s)" + (f"; newest {latest}." if latest else "."), "",
     ]  # fmt: skip
+    bands = band_figures(submissions, protocols)
     for protocol, subs in _by_protocol(submissions, protocols):
         cols = columns(protocol)
         lines += [f"## {_md(protocol.name)}", "", f"{_md(protocol.description)}.", ""]
@@ -288,6 +318,10 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
             cells["system"] = ("", f"[{_md(sub['name'])}](submissions/{sub['name']}.json)")
             lines.append("| " + " | ".join(_md(cells[c.key][1]) if c.key != "system" else cells[c.key][1] for c in cols) + " |")
         lines.append("")
+        if protocol.name in bands and band_file(protocol):
+            text, command = _band_caption(submissions, protocol)  # (band_file: a protocol name safe in a code span)
+            lines += [f"![references' AP vs distance, {_md(protocol.name)}]({band_file(protocol)})", "",
+                      f"{_md(text)} `{command}`.", ""]
     lines += [
         "## Reproduce the reference submissions", "",
         "The 13 paper cameras with YOLOv5n on each protocol's collection (all conditions):", "",
@@ -316,6 +350,7 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
     csp = f"default-src 'none'; style-src {_csp_hash(style)}; script-src {_csp_hash(script)}; base-uri 'none'; form-action 'none'"
     latest = max((s["created_at"] for s in submissions), default=None)
     day, night = _ranked_labels(protocols)
+    bands = band_figures(submissions, protocols)
     out = [
         "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
         f'<meta http-equiv="Content-Security-Policy" content="{esc(csp)}">',
@@ -352,7 +387,12 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
                 body = f'<a href="submissions/{esc(sub["name"])}.json">{esc(text)}</a>' if c.key == "system" else esc(text)
                 tds.append(f'<td data-v="{esc(value)}"{_cell_class(c)}>{body}</td>')
             out.append(f'<tr data-name="{esc(sub["name"])}">' + "".join(tds) + "</tr>")
-        out += ["</tbody>", "</table></div>", "</section>"]
+        out += ["</tbody>", "</table></div>"]
+        if protocol.name in bands:
+            out += ['<figure class="band">', bands[protocol.name].rstrip("\n"),
+                    "<figcaption>{} <code>{}</code>.</figcaption>".format(*map(esc, _band_caption(submissions, protocol))),
+                    "</figure>"]
+        out.append("</section>")
     out += [f"<script>{script}</script>", "</body>", "</html>", ""]
     return "\n".join(out)
 
@@ -368,9 +408,18 @@ def _cell_class(column: Column) -> str:
 
 
 def render_leaderboard(leaderboard_dir: str | Path = "leaderboard") -> tuple[Path, Path]:
-    """Validate every submission, then write ``README.md`` and ``index.html`` atomically; returns their paths."""
+    """Validate every submission, then write the references' band figures, ``README.md`` and
+    ``index.html`` atomically (a band file no protocol draws any more is removed); returns the
+    paths of README.md and index.html."""
     leaderboard_dir = Path(leaderboard_dir)
     protocols = load_protocols(leaderboard_dir)
     submissions = load_submissions(leaderboard_dir, protocols)
     readme, page = render_markdown(submissions, protocols), render_html(submissions, protocols)
+    figures = {band_file(protocols[name]): svg for name, svg in band_figures(submissions, protocols).items()
+               if band_file(protocols[name])}
+    for name, svg in sorted(figures.items()):
+        write_atomic(leaderboard_dir / name, svg)
+    for stale in sorted(leaderboard_dir.glob("references-*.svg")):
+        if stale.name not in figures:
+            stale.unlink()
     return write_atomic(leaderboard_dir / "README.md", readme), write_atomic(leaderboard_dir / "index.html", page)
