@@ -13,10 +13,11 @@ import tempfile
 from pathlib import Path
 
 
-def write_atomic(path: str | Path, text: str) -> Path:
+def write_atomic(path: str | Path, text: str | bytes) -> Path:
     """Write ``text`` to ``path`` through a temporary file and ``os.replace``; returns ``path``.
 
-    UTF-8 with the text's own ``\\n`` line endings on every platform (same inputs → same bytes).
+    UTF-8 with the text's own ``\\n`` line endings on every platform (same inputs → same bytes);
+    bytes are written as they are.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -24,7 +25,7 @@ def write_atomic(path: str | Path, text: str) -> Path:
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:
-            f.write(text.encode("utf-8"))
+            f.write(text.encode("utf-8") if isinstance(text, str) else text)
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, 0o644)  # mkstemp makes 0600 files; results and tables are meant to be read

@@ -84,10 +84,12 @@ WINGS = {
     "measure": (("camera",), "it measures a camera (MTF, photon transfer, the figures a spec implies) by running its stages"),
     "scoring": ((), "AP and OD50 come from ground truth and detections alone, whoever made them"),
     "result_files": (("scoring",), "the files runs and sweeps write hold what the scoring returns (od50.json: its bootstrap)"),
-    "experiments": (("camera", "detectors", "measure", "scoring", "result_files"),
-                    "a run chains camera, detector and scoring over a collection and writes result files"),
     "leaderboard": (("camera", "detectors", "scoring", "result_files"),
                     "it judges a submission from its records, spec and detector, and runs no experiment"),
+    "experiments": (("camera", "detectors", "measure", "scoring", "result_files", "leaderboard"),
+                    "a run chains camera, detector and scoring over a collection and writes result files; compare "
+                    "and report put runs beside leaderboard submissions (their shipped detections, the references' "
+                    "band) and name conditions by the protocols' labels"),
     "publish": (("camera", "detectors", "measure", "scoring", "result_files", "experiments"),
                 "what the docs publish (tables, the results page, studies' CSVs) is made from runs and sweeps"),
     "cli": (("camera", "detectors", "measure", "scoring", "result_files", "experiments", "leaderboard", "publish"),

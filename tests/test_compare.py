@@ -9,9 +9,11 @@ import pytest
 from typer.testing import CliRunner
 
 from benchmark.experiments.compare import CompareError, Side, compare_runs, load_side, verdict
+from benchmark.leaderboard.protocols import condition_label
 from synthetic_scoring import synthetic_collection
 
 SHA = "f" * 64
+NIGHT = condition_label("night")  # verdicts open with what the condition physically is
 
 
 def side(gt, dets, name="camA", condition="day", sha=SHA, folder="run") -> Side:
@@ -42,7 +44,7 @@ def test_identical_runs_give_zero_and_no_difference(run20):
     assert res["delta_od50"]["delta_m"] == 0.0
     assert res["delta_od50"]["ci95_m"] == [0.0, 0.0]
     assert all(r["delta_ap"] == 0.0 and r["ci95"] == [0.0, 0.0] for r in res["per_distance"])
-    assert res["verdict"].startswith("no difference resolved between camA and camB by day")
+    assert res["verdict"].startswith("daylight: no difference resolved between camA and camB: ΔOD50")
 
 
 def test_shifted_run_has_the_known_sign(run20):
@@ -51,11 +53,11 @@ def test_shifted_run_has_the_known_sign(run20):
     res = compare_runs(side(gt, dets, name="good"), side(gt, worse, name="bad"), n_resamples=200)
     od = res["delta_od50"]
     assert od["delta_m"] > 0 and od["ci95_m"][0] > 0, od
-    assert res["verdict"].startswith("good detects cars ") and "farther than bad by day" in res["verdict"]
+    assert res["verdict"].startswith("daylight: good detects cars ") and "farther than bad (95 %" in res["verdict"]
     assert sum(r["delta_ap"] for r in res["per_distance"]) > 0
     flipped = compare_runs(side(gt, worse, name="bad"), side(gt, dets, name="good"), n_resamples=200)
     assert flipped["delta_od50"]["delta_m"] == pytest.approx(-od["delta_m"])
-    assert flipped["verdict"].startswith("good detects cars ")  # the farther one is named first
+    assert flipped["verdict"].startswith("daylight: good detects cars ")  # the farther one is named first
 
 
 def test_mismatched_collections_are_refused(run20):
@@ -90,7 +92,7 @@ def test_censored_od50_is_not_a_difference():
            "confidence_level": 0.95, "delta_od50": {"delta_m": None, "sd_m": None, "ci95_m": [None, None]},
            "per_distance": [{"distance_m": 100.0, "ci95": [0.3, 0.6]}, {"distance_m": 25.0, "ci95": [-0.01, 0.04]}]}
     text = verdict(res)
-    assert text.startswith("cam12 detects cars farther than cam01 by day, by at least 110 m (OD50 > 200 m vs 89.7 m")
+    assert text.startswith("daylight: cam12 detects cars farther than cam01, by at least 110 m (OD50 > 200 m vs 89.7 m")
     assert "AP differs at 100 m" in text and "281" not in text
 
 
@@ -143,7 +145,7 @@ def test_both_blind_beyond_25m_is_said_plainly_not_called_a_difference():
     assert far["found_b"] == 0 and far["cars_needed"] == 3 and not far["resolved"] and far["blind"]  # ... on noise
     near = next(r for r in res["per_distance"] if r["distance_m"] == 25.0)
     assert near["found_a"] == near["found_b"] == 10 and not near["blind"]
-    assert "both blind at night beyond 25 m" in res["verdict"]
+    assert res["verdict"].startswith(f"{NIGHT}: ") and "both blind beyond 25 m" in res["verdict"]
     assert "AP differs at" not in res["verdict"] and "\n" not in res["verdict"]
 
 
@@ -153,7 +155,7 @@ def test_both_blind_everywhere_is_no_difference():
              for im in gt["images"]]
     res = compare_runs(side(gt, noise, condition="night"), side(gt, noise[:5], name="camB", condition="night"),
                        n_resamples=50)
-    assert res["verdict"] == ("camA and camB are both blind at night at every measured distance (25 to 200 m: neither "
+    assert res["verdict"] == (f"{NIGHT}: camA and camB are both blind at every measured distance (25 to 200 m: neither "
                               "camera found 3 of the 10 cars: a car detection of score >= 0.25 on the car at IoU >= 0.5): "
                               "no difference is called")
 
@@ -173,7 +175,7 @@ def test_cli_says_both_blind(tmp_path):
     res = CliRunner().invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "100"])
     assert res.exit_code == 0, res.output
     text = " ".join(res.output.split())
-    assert "both blind at night beyond 25 m" in text and "AP differs at" not in text
+    assert f"{NIGHT}: " in text and "both blind beyond 25 m" in text and "AP differs at" not in text
     assert "0/10" in text and "10/10" in text and "blind" in text
     assert sorted(p.name for p in tmp_path.rglob("*")) == before  # no --out: nothing written
 
@@ -239,10 +241,10 @@ def test_censored_od50_is_compared_by_ap_range():
     rng = res["delta_ap_range"]
     assert (res["a"]["ap_range_m"], res["b"]["ap_range_m"]) == pytest.approx((200.0, 125.0))
     assert rng["delta_m"] == pytest.approx(75.0) and rng["resolved"]
-    assert res["verdict"].startswith("camA detects cars farther than camB by day: AP range 200 vs 125 m, 75 ± 0 m more "
+    assert res["verdict"].startswith("daylight: camA detects cars farther than camB: AP range 200 vs 125 m, 75 ± 0 m more "
                                      "(95 %: 75–75 m; OD50 > 200 m vs 125.0 m: outside the measured distances")
     same = compare_runs(side(gt, _perfect(gt), name="camA"), side(gt, _perfect(gt), name="camB"), n_resamples=50)
-    assert same["verdict"].startswith("no difference resolved between camA and camB by day: ΔAP range = +0 ± 0 m")
+    assert same["verdict"].startswith("daylight: no difference resolved between camA and camB: ΔAP range = +0 ± 0 m")
 
 
 def test_rows_carry_miss_rate_false_positives_and_hold_their_points(run20):

@@ -59,6 +59,7 @@ def page(tmp_path_factory):
     (lb / "protocols.yaml").write_text(
         "protocols:\n  smoke:\n    description: smoke\n    manifests_sha256: [" + manifest.sha256() + "]\n"
         "    distances_m: [25, 50, 75, 100, 150, 200]\n    conditions: [day, night]\n    required_conditions: [day]\n"
+        "    references: sys-*\n"  # the band is drawn: inline SVG under the page's CSP
     )  # fmt: skip
     protocols = load_protocols(lb)
     for i, (cam, half) in enumerate(SYSTEMS):
@@ -83,6 +84,7 @@ def test_page_loads_without_console_errors(chromium_works, page, tmp_path):
     dom, console = _browse(page.as_uri(), tmp_path / "profile")
     assert console == []  # no errors, no CSP violations, nothing logged
     assert 'data-sorted="rank"' in dom  # the script ran under the page's CSP
+    assert '<figure class="band">' in dom and dom.count("<polygon") == 2  # the references' band: day and night
     assert _order(dom) == ["sys-cam03", "sys-cam12", "sys-cam01"]
 
 
@@ -134,4 +136,5 @@ def test_committed_table_fits_1400_px_without_scrolling_sideways(chromium_works,
     widths = json.loads(found.group(1))
     assert widths["page"][0] <= widths["page"][1], widths
     assert widths["tables"] and all(scroll <= client for scroll, client in widths["tables"]), widths
-    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text and "Night AP range (m)" in text
+    assert "MTF50 (cy/mrad)" in text and "Focal (mm)" in text and "FOV (°)" in text and "0.1–1 lux image plane, sky raised AP range (m)" in text
+    assert text.count('<figure class="band">') == 2  # the references' band under each protocol's table fits too

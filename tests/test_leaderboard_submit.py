@@ -301,7 +301,7 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     row = next(line for line in lines if "cam01-yolov5n-smoke" in line)
     header = next(line for line in lines if line.startswith("| # |"))
     cells = dict(zip([c.strip() for c in header.strip("|").split("|")], [c.strip() for c in row.strip("|").split("|")]))
-    assert cells["#"] == "1" and cells["Camera"] == "cam01" and cells["Day OD50 (m)"].split(" ±")[0] == expected
+    assert cells["#"] == "1" and cells["Camera"] == "cam01" and cells["Daylight OD50 (m)"].split(" ±")[0] == expected
     html = (lb / "index.html").read_text()
     assert 'href="submissions/cam01-yolov5n-smoke.json"' in html and f">{expected}" in html
     assert math.isclose(float(cells["Pixel (µm)"]), 4.2) and math.isclose(float(cells["f-number"]), 3.1)
@@ -311,20 +311,29 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
 
 def test_committed_reference_submissions_are_valid_and_rendered():
     """The reference submissions in leaderboard/ still pass every check against the
-    packaged protocols (a manifest change must come with new references), and the
-    committed table is what `benchmark leaderboard` renders from them."""
-    from benchmark.leaderboard import check_submission_file, load_protocols, load_submissions, render_html, render_markdown
+    packaged protocols (a manifest change must come with new references; made before detections
+    shipped, each is accepted with its warning), and the committed table and band figures are
+    what `benchmark leaderboard` renders from them."""
+    from benchmark.leaderboard import (
+        NoDetectionsWarning, check_submission_file, load_protocols, load_submissions, render_html, render_markdown,
+    )
+    from benchmark.leaderboard.render import band_figures
 
     folder = REPO / "leaderboard"
     subs = sorted((folder / "submissions").glob("*.json"))
     assert len(subs) >= 13
     for path in subs:
-        data = check_submission_file(path)
+        with pytest.warns(NoDetectionsWarning, match="made before detections shipped"):
+            data = check_submission_file(path)
         assert data["collection"]["protocol"] in {"quick", "metric-300"}
     protocols = load_protocols(folder)
     submissions = load_submissions(folder, protocols)
     assert render_markdown(submissions, protocols) == (folder / "README.md").read_text()
     assert render_html(submissions, protocols) == (folder / "index.html").read_text()
+    figures = band_figures(submissions, protocols)
+    assert sorted(figures) == ["metric-300", "quick"]
+    for name, svg in figures.items():
+        assert (folder / f"references-{name}.svg").read_text() == svg
 
 
 def test_tree_hash_of_a_missing_folder_is_empty(tmp_path):

@@ -19,6 +19,7 @@ from benchmark.leaderboard import (
     dumps_submission,
     find_runs,
     load_protocols,
+    save_submission,
     tree_sha256,
     write_submission,
 )
@@ -293,6 +294,11 @@ def _invoke(app, args):
     return res, stderr
 
 
+def _save(world, folder, sub=None):
+    """``sub`` (default: the good submission) written into ``folder`` with the good one's detections beside it."""
+    return save_submission(world["good"] if sub is None else sub, folder, packs=world["good"].packs)
+
+
 @pytest.mark.parametrize("case", BAD, ids=[c[0] for c in BAD])
 def test_bad_submission_refused(app, world, tmp_path, case):
     case_id, make, file_name, expected = case
@@ -311,15 +317,15 @@ def test_bad_submission_refused(app, world, tmp_path, case):
 
 
 def test_good_submission_passes_and_touches_nothing(app, world, tmp_path):
-    path = tmp_path / "good.json"
-    path.write_text(dumps_submission(world["good"]))
+    path = _save(world, tmp_path)
     before = tree_sha256(world["leaderboard"])
     root = world["root"]
     res, _ = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
                            "--detections", root / "cam07" / "day" / "detections.json",
                            "--groundtruth", root / "cam07" / "day" / "groundtruth.json"])  # fmt: skip
     assert res.exit_code == 0, res.output
-    assert "ok: good.json (protocol smoke, conditions day, night; AP recomputed from 1 detections file(s))" in res.output
+    assert ("ok: good.json (protocol smoke, conditions day, night; AP recomputed from its shipped detections "
+            "(2 condition(s)); AP recomputed from 1 detections file(s))") in res.output
     # (the synthetic runs draw a new ground truth per condition; real runs of one camera share it)
     res, _ = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
                            "--detections", root / "cam07" / "night" / "detections.json",
@@ -349,8 +355,7 @@ def test_a_reproduction_of_an_entry_is_not_a_second_row(app, world, tmp_path):
     sub["name"] = "existing-again"
     for cond in sub["conditions"].values():
         cond["detections_sha256"] = hashlib.sha256(cond["detections_sha256"].encode()).hexdigest()
-    path = tmp_path / "existing-again.json"
-    path.write_text(dumps_submission(sub))
+    path = save_submission(sub, tmp_path, packs=world["existing"].packs)
     before = tree_sha256(world["leaderboard"])
     res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"]])
     assert res.exit_code == 2 and stderr.strip().splitlines() == [
@@ -359,7 +364,7 @@ def test_a_reproduction_of_an_entry_is_not_a_second_row(app, world, tmp_path):
     assert tree_sha256(world["leaderboard"]) == before
     lb = tmp_path / "lb"
     shutil.copytree(world["leaderboard"], lb)
-    shutil.copy(path, lb / "submissions" / path.name)
+    shutil.copy(path, lb / "submissions" / path.name)  # the JSON alone: a duplicate is named before missing files
     before = tree_sha256(lb)
     res, stderr = _invoke(app, ["leaderboard", "--dir", lb])
     assert res.exit_code == 2 and len(stderr.strip().splitlines()) == 1, stderr
@@ -369,26 +374,28 @@ def test_a_reproduction_of_an_entry_is_not_a_second_row(app, world, tmp_path):
 
 @pytest.mark.parametrize("what", ["ap", "ap50"])
 def test_ap_mismatch_with_detections(app, world, tmp_path, what):
+    """An AP edited beyond float rounding (2e-6) is refused from the detections the submission ships,
+    naming the field, the claimed and the recomputed value; from a run's files (--detections) too."""
     sub = copy.deepcopy(world["good"])
     row = sub["conditions"]["day"]["per_distance"][2]
+    original = row[what]
     row[what] = round(row[what] + 2e-6, 9) if row[what] < 0.5 else row[what] - 2e-6  # beyond the 1e-6 tolerance
     _fix_od50(sub)
-    path = tmp_path / "good.json"
-    path.write_text(dumps_submission(sub))
+    path = _save(world, tmp_path, sub)
     day = world["root"] / "cam07" / "day"
     before = tree_sha256(world["leaderboard"])
     args = ["submit", "--check", path, "--leaderboard", world["leaderboard"]]
-    res, _ = _invoke(app, args)
-    assert res.exit_code == 0, res.output  # without the detections the edit cannot be seen
+    res, stderr = _invoke(app, args)
+    assert res.exit_code == 2 and stderr.strip().splitlines() == [
+        f"error: good.json: conditions.day.per_distance[75 m].{what} is {row[what]:.6f}, but {original:.6f} recomputed "
+        "from its shipped detections"], stderr
     res, stderr = _invoke(app, [*args, "--detections", day / "detections.json", "--groundtruth", day / "groundtruth.json"])
-    assert res.exit_code == 2
-    assert f"conditions.day: {what.upper()} at 75 m is" in stderr and "recomputed from detections.json" in stderr, stderr
+    assert res.exit_code == 2 and "recomputed from" in stderr, stderr
     assert tree_sha256(world["leaderboard"]) == before
 
 
 def test_detections_of_another_system(app, world, tmp_path):
-    path = tmp_path / "good.json"
-    path.write_text(dumps_submission(world["good"]))
+    path = _save(world, tmp_path)
     other = world["root"] / "cam03" / "day"
     res, stderr = _invoke(app, ["submit", "--check", path, "--leaderboard", world["leaderboard"],
                                 "--detections", other / "detections.json", "--groundtruth", other / "groundtruth.json"])  # fmt: skip
@@ -480,7 +487,7 @@ def _laughs(levels: int) -> str:
 @pytest.mark.parametrize(("text", "expected"), [
     (_laughs(6), "invalid protocols file (an alias (*name): a protocols file holds none at line 3)"),
     (PROTOCOLS.format(sha="0" * 64) + "accepted_by: me\n",
-     "invalid protocols file (unknown top-level key(s) accepted_by (it holds only 'protocols'))"),
+     "invalid protocols file (unknown top-level key(s) accepted_by (it holds only 'labels', 'protocols'))"),
     (PROTOCOLS.format(sha="0" * 64).replace("n_environments", "n_environment"),
      "invalid protocols file (protocol 'smoke': unknown key(s) n_environment"),
     (PROTOCOLS.format(sha="0" * 64).replace("description: smoke", "description: [a, b]"),

@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from benchmark.experiments import report as report_module
+from benchmark.leaderboard.protocols import condition_label as L  # tables and figures name a condition by what it is
 from benchmark.scoring import MIN_ENVIRONMENTS
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from test_sweep_cache import make_fake_sweep  # the fake runs (tests/ is on sys.path)
@@ -61,7 +62,7 @@ def test_sweep_report_is_self_contained(sweep_dir, page):
     assert len(images) == len(figures) + thumbs
     for name in figures:
         assert (sweep_dir / "figures" / f"{name}.png").is_file() and (sweep_dir / "figures" / f"{name}.svg").is_file()
-    assert [h for h in re.findall(r"<h3>([^<]+)</h3>", page)][:2] == ["25 m · day", "25 m · night"]
+    assert [h for h in re.findall(r"<h3>([^<]+)</h3>", page)][:2] == [f"25 m · {L('day')}", f"25 m · {L('night')}"]
 
 
 def test_sweep_report_table_matches_od50_csv(sweep_dir, page):
@@ -73,7 +74,7 @@ def test_sweep_report_table_matches_od50_csv(sweep_dir, page):
                                                            "focal length (mm)", "FOV (°)", "OD50 ± SD (m)", "95 % interval (m)"]
     assert (od50.n_environments == 4).all() and MIN_ENVIRONMENTS > 4  # too few: every figure is marked
     for _, row in od50.iterrows():
-        shown = table[(table.camera == row.camera) & (table.condition == row.condition)].iloc[0]
+        shown = table[(table.camera == row.camera) & (table.condition == L(row.condition))].iloc[0]
         assert shown["OD50 ± SD (m)"] == f"{row.od50_m:.1f} ± {row.sd_m:.1f}†" or not np.isfinite(row.od50_m)
         assert shown["AP range ± SD (m)"] == f"{row.ap_range_m:.1f} ± {row.ap_range_sd_m:.1f}†"
         assert shown["AP range 95 % (m)"] == f"[{row.ap_range_ci95_lo_m:.1f}, {row.ap_range_ci95_hi_m:.1f}]"
@@ -82,7 +83,7 @@ def test_sweep_report_table_matches_od50_csv(sweep_dir, page):
                               f"{MIN_ENVIRONMENTS} needed for a verdict (docs/scoring.md)")
     assert f"† from fewer than {MIN_ENVIRONMENTS} environments per distance" in results
     ap = pd.read_csv(sweep_dir / "sweep.csv").query("camera == 'cam05' and condition == 'night' and distance_m == 50")
-    shown = table.query("camera == 'cam05' and condition == 'night'").iloc[0]["AP 50 m"]
+    shown = table.query("camera == 'cam05' and condition == @L('night')").iloc[0]["AP 50 m"]
     assert float(shown) == pytest.approx(ap.ap.iloc[0], abs=5e-4)
 
 
@@ -144,7 +145,7 @@ def test_miss_rate_and_false_positives_per_distance(sweep_dir, page):
     table = _html_table(section)
     run = sweep_dir / "runs" / "cam01-day"
     expected = working_point(json.loads((run / "groundtruth.json").read_text()), json.loads((run / "detections.json").read_text()))
-    shown = table.query("camera == 'cam01' and condition == 'day'").iloc[0]
+    shown = table.query("camera == 'cam01' and condition == @L('day')").iloc[0]  # named by what it is
     assert shown["25 m"] == f"{expected[25.0]['miss_rate']:.2f} / {expected[25.0]['false_positives_per_image']:.2f}"
     assert list(table.columns) == ["camera", "condition", "25 m", "50 m", "75 m", "100 m", "150 m", "200 m"]
 
@@ -163,4 +164,4 @@ def test_no_line_is_fitted_through_too_few_environments():
 
     assert fitted_lines(MIN_ENVIRONMENTS)[0] == 1
     n, legend = fitted_lines(MIN_ENVIRONMENTS - 1)
-    assert n == 0 and legend == ["day: no fit (3 from too few environments: not fitted)"]
+    assert n == 0 and legend == [f"{L('day')}: no fit (3 from too few environments: not fitted)"]

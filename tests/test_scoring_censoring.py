@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from benchmark.leaderboard.protocols import condition_label
 from benchmark.scoring import BOOTSTRAP_RESAMPLES, format_od50, od50, od50_censoring
 
 D = [25, 50, 75, 100, 150, 200]
@@ -98,7 +99,7 @@ def test_figure_labels_bounds(tmp_path):
                        "censored": ["", "", "", ">"], "bound_m": [np.nan, np.nan, np.nan, 200.0]})
     fig = spm.od50_vs_mtf50(od, tmp_path / "f", measured_range_m=(25.0, 200.0))
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert labels == ["day: slope 1.00 m per cy/mm (1 OD50 > 200 m (▲, lower bound): hollow, not fitted)"]
+    assert labels == [condition_label("day") + ": slope 1.00 m per cy/mm (1 OD50 > 200 m (▲, lower bound): hollow, not fitted)"]
     assert max(np.max(line.get_ydata()) for line in fig.axes[0].get_lines() if len(line.get_ydata())) <= 200.0
 
 

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from benchmark.experiments import spm
+from benchmark.leaderboard.protocols import condition_label as L  # figures name a condition by what it is
 
 DISTANCES = (25.0, 50.0, 75.0, 100.0, 150.0, 200.0)
 
@@ -54,7 +55,7 @@ def test_interpolation_averages_repeats_and_rejects_degenerate_input():
 def test_spm_mtf50_writes_png_and_svg(tmp_path):
     fig = spm.spm_mtf50(synthetic_sweep(), tmp_path / "spm_mtf50", mark_mtf50=100)
     assert len(fig.axes) == 3  # day, night, colourbar
-    assert [a.get_title() for a in fig.axes[:2]] == ["day", "night"]
+    assert [a.get_title() for a in fig.axes[:2]] == [L("day"), L("night")]
     png, svg = tmp_path / "spm_mtf50.png", tmp_path / "spm_mtf50.svg"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
     text = svg.read_text()
@@ -100,7 +101,7 @@ def test_od50_vs_mtf50_slope_in_legend(tmp_path):
     od.loc[7, "od50_m"] = np.inf  # never falls to 0.5: left out of the fit
     fig = spm.od50_vs_mtf50(od, tmp_path / "od50")
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert labels == ["day: slope 0.80 m per cy/mm", "night: slope 0.30 m per cy/mm"]
+    assert labels == [f"{L('day')}: slope 0.80 m per cy/mm", f"{L('night')}: slope 0.30 m per cy/mm"]
     assert (tmp_path / "od50.png").is_file() and (tmp_path / "od50.svg").is_file()
     # an OD50 outside the measured distances is an extrapolation: drawn, not fitted
     od.loc[3, "od50_m"] = 5000.0
@@ -108,8 +109,8 @@ def test_od50_vs_mtf50_slope_in_legend(tmp_path):
     plt.close(fig)
     fig = spm.od50_vs_mtf50(od, tmp_path / "od50", measured_range_m=(25.0, 200.0))
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert labels == ["day: slope 0.80 m per cy/mm (1 extrapolated: hollow, not fitted)",
-                      "night: slope 0.30 m per cy/mm (1 extrapolated: hollow, not fitted)"]
+    assert labels == [f"{L('day')}: slope 0.80 m per cy/mm (1 extrapolated: hollow, not fitted)",
+                      f"{L('night')}: slope 0.30 m per cy/mm (1 extrapolated: hollow, not fitted)"]
     assert fig.axes[0].get_ylim()[1] < 5000.0  # the extrapolation does not squash the axes
     assert spm.fit_line([1, 2, 3], [2, 4, 6]) == pytest.approx((2.0, 0.0))
     assert np.isnan(spm.fit_line([1, 1], [2, 3])[0])

@@ -6,6 +6,7 @@ stderr and exit code 2; ``--check`` and refused submissions never touch the lead
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -37,6 +38,7 @@ def submit(
         write_submission,
     )  # fmt: skip
     from benchmark.leaderboard.submission import software_differences
+    from benchmark.leaderboard.validate import NoDetectionsWarning
 
     try:
         check_leaderboard_dir(leaderboard, "--leaderboard")
@@ -44,10 +46,17 @@ def submit(
             if results_dir is not None or name is not None:
                 fail("--check FILE takes no RESULTS_DIR or --name")
             lb = leaderboard if leaderboard.is_dir() else None
-            data = check_submission_file(check, leaderboard_dir=lb, detections=detections or [], groundtruth=groundtruth)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", NoDetectionsWarning)
+                data = check_submission_file(check, leaderboard_dir=lb, detections=detections or [], groundtruth=groundtruth)
             conditions = ", ".join(sorted(data["conditions"]))
-            recomputed = f"; AP recomputed from {len(detections)} detections file(s)" if detections else ""
+            shipped = [c for c, v in data["conditions"].items() if v.get("shipped_detections_sha256")]
+            recomputed = (f"; AP recomputed from its shipped detections ({len(shipped)} condition(s))" if shipped else "")
+            recomputed += f"; AP recomputed from {len(detections)} detections file(s)" if detections else ""
             typer.echo(f"ok: {check.name} (protocol {data['collection']['protocol']}, conditions {conditions}{recomputed})")
+            for warning in caught:
+                if issubclass(warning.category, NoDetectionsWarning):
+                    typer.echo(f"warning: {warning.message}", err=True)
             differences = software_differences(data)
             if differences:  # a reproduction here need not give the same bytes (docs/performance.md)
                 typer.echo(f"warning: {check.name} was {' and '.join(differences)}: a rerun here may give "

@@ -16,6 +16,7 @@ from benchmark.cli.publish import app as publish_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
 from benchmark.experiments import compare
+from benchmark.leaderboard.protocols import condition_label
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.detectability import FOUND_IOU, FOUND_SCORE
 from benchmark.suggest import did_you_mean
@@ -124,7 +125,7 @@ def run(
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     except OSError as exc:  # a full disk, an unwritable folder: nothing written (run_camera stages)
         fail(cannot_write(out, exc))
-    title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition} · {detector.name}"
+    title = f"{cam.name} ({cam.pixel_um} µm, f/{cam.f_number}) · {condition_label(condition)} · {detector.name}"
     if policy is not None:
         title += f" · exposure {format_exposure(policy)}"
     table = Table(title=title, caption=WORKING_POINT_CAPTION)
@@ -244,12 +245,12 @@ def sweep(
     table.add_column("camera")
     table.add_column("MTF50 (cy/mm)", justify="right", no_wrap=True)
     table.add_column("cy/mrad (f)", justify="right", no_wrap=True)
-    for condition in conds:
-        table.add_column(condition, justify="right")
+    for condition in conds:  # named by what it physically is (protocols.yaml labels)
+        table.add_column(condition_label(condition), justify="right")
     ranges = Table(title="AP range ± SD (m): area under AP vs distance, defined where OD50 is censored (docs/scoring.md)")
     ranges.add_column("camera")
     for condition in conds:
-        ranges.add_column(condition, justify="right")
+        ranges.add_column(condition_label(condition), justify="right")
     for camera_name, rows in od50_table.groupby("camera", sort=False):
         by_condition = rows.set_index("condition")
         cells = [sweep_module.od50_cell(by_condition.loc[condition]) for condition in conds]
@@ -275,9 +276,12 @@ def report(
         metavar="RESULTS_DIR")],
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help=(
         "HTML page (default RESULTS_DIR/report.html for one folder; required for several)"))] = None,
+    references: Annotated[Optional[str], typer.Option(help=(
+        "a leaderboard protocol (quick, metric-300): draw the runs' AP vs distance over its reference submissions' band"))] = None,
+    leaderboard: Annotated[Path, typer.Option("--leaderboard", help="leaderboard folder --references reads")] = Path("leaderboard"),
 ) -> None:
     """One self-contained HTML page: AP curves, SPMs, OD50 vs MTF50, table, image strips (of one folder, or of
-    several run and sweep folders side by side)."""
+    several run and sweep folders side by side); with --references, the runs over the references' band."""
     from benchmark.experiments.report import report as write_report
     from metricscenes.outputs import RUN, SWEEP, check_output, folder_kind
 
@@ -294,7 +298,8 @@ def report(
     try:  # the page, figures/ and report_table.csv: in RESULTS_DIR, or outside every collection, run and leaderboard
         check_output(out if out is not None else results_dirs[0] / "report.html", "--out", given=given)
         with err.status("writing the report"):
-            page = write_report(results_dirs if len(results_dirs) > 1 else results_dirs[0], out)
+            page = write_report(results_dirs if len(results_dirs) > 1 else results_dirs[0], out, references=references,
+                                leaderboard_dir=leaderboard)
     except (ValueError, OSError, KeyError) as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     console.print(f"wrote {page} (figures in {page.parent / 'figures'})")

@@ -35,7 +35,8 @@ score 0.02). A difference at a distance is *called* only when its 95 % interval 
 :data:`FOUND_SCORE` overlapping the car's box at IoU ≥ :data:`FOUND_IOU`
 (:func:`benchmark.scoring.detection_rates`, ``benchmark score``'s working point). Where
 neither camera finds that many, both are *blind* there, and the verdict says so ("both
-blind at night beyond 25 m") instead of calling a difference (docs/scoring.md).
+blind beyond 25 m") instead of calling a difference (docs/scoring.md). The verdict opens with what
+the condition physically is (:func:`benchmark.leaderboard.protocols.condition_label`).
 """
 
 from __future__ import annotations
@@ -59,7 +60,6 @@ from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, perc
 from benchmark.suggest import did_you_mean
 
 COMPARE_FORMAT = "metricscenes-compare/1"
-CONDITION_WORDS = {"day": "by day", "night": "at night", "dusk": "at dusk"}
 MIN_FOUND_CARS = 3
 """Fewest cars the camera with the higher AP must have found at a distance for a difference there to be called."""
 MIN_FOUND_FRACTION = 0.2
@@ -101,6 +101,7 @@ class Side(RunFolder):
 
     groundtruth: dict
     detections: list
+    name: str | None = None  # a leaderboard submission's name (a reference side), shown as its label
 
     @property
     def manifest_sha256(self) -> str:
@@ -161,6 +162,53 @@ def load_side(folder: str | Path) -> Side:
         raise CompareError(f"{folder}: unreadable JSON ({exc})") from None
 
 
+def submission_path(reference: str | Path, leaderboard_dir: str | Path = "leaderboard") -> Path:
+    """The submission file of ``reference``: a path to a ``.json``, or a name on the leaderboard
+    (``leaderboard_dir/submissions/<name>.json``)."""
+    reference = str(reference)
+    if reference.endswith(".json") or "/" in reference or "\\" in reference:
+        return Path(reference)
+    return Path(leaderboard_dir) / "submissions" / f"{reference}.json"
+
+
+def load_reference(reference: str | Path, condition: str, leaderboard_dir: str | Path = "leaderboard") -> Side:
+    """One condition of a leaderboard submission as a comparison side, from the detections and
+    ground truth it ships (checksummed: :mod:`benchmark.leaderboard.detections`); refused in one
+    line where it has no such condition or ships no detections (made before they shipped)."""
+    from benchmark.leaderboard.detections import pack_path, read_pack
+    from benchmark.leaderboard.schema import SubmissionError
+    from benchmark.leaderboard.validate import read_submission_file
+    from benchmark.result_files import CameraRecord, CollectionRecord, RunResults
+
+    path = submission_path(reference, leaderboard_dir)
+    if not path.is_file():
+        held = sorted(p.stem for p in path.parent.glob("*.json")) if path.parent.is_dir() else []
+        raise CompareError(f"--reference {reference}: no such submission ({path}){did_you_mean(path.stem, held)}")
+    try:
+        data = read_submission_file(path)
+        if not isinstance(data, dict) or not isinstance(data.get("conditions"), dict):
+            raise SubmissionError(f"{path.name}: not a submission")
+        cond = data["conditions"].get(condition)
+        if not isinstance(cond, dict):
+            raise CompareError(f"{path.stem} has no condition {condition!r} (it has: {', '.join(sorted(data['conditions']))})")
+        digest = cond.get("shipped_detections_sha256")
+        if digest is None:
+            raise CompareError(f"{path.stem} carries no detections (made before detections shipped): it cannot be paired "
+                               "by scene; `benchmark report RUN --references PROTOCOL` draws a run over the references' AP")
+        body = read_pack(pack_path(path, condition), expected_sha256=digest,
+                         source=f"{path.stem}.detections/{condition}.json.gz")
+        results = RunResults(camera=CameraRecord(name=data["camera"]["name"]), condition=condition,
+                             collection=CollectionRecord(**{k: data["collection"][k] for k in ("name", "protocol", "manifest_sha256")}),
+                             scoring_backend=data["scoring"]["backend"])
+    except CompareError:
+        raise
+    except SubmissionError as exc:
+        raise CompareError(str(exc)) from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CompareError(f"{path.name}: not a submission ({type(exc).__name__}: {exc})".splitlines()[0]) from None
+    return Side(path, results, body["groundtruth"], body["detections"], name=data["name"])
+
+
 def check_comparable(a: Side, b: Side) -> None:
     """Raise :class:`CompareError` (one line) unless A and B share collection and scenes."""
     if not a.manifest_sha256 or a.manifest_sha256 != b.manifest_sha256:
@@ -174,6 +222,8 @@ def check_comparable(a: Side, b: Side) -> None:
 
 
 def _label(side: Side, other: Side) -> str:
+    if side.name is not None:
+        return side.name
     if side.camera != other.camera:
         return side.camera
     if side.condition != other.condition:
@@ -314,10 +364,20 @@ def _rate(x: float | None) -> str:
     return "–" if x is None else f"{x:.2f}"
 
 
-def _when(cond_a: str, cond_b: str) -> tuple[str, str]:
-    if cond_a == cond_b:
-        return CONDITION_WORDS.get(cond_a, f"in {cond_a}" if cond_a else ""), ""
-    return "", f" ({cond_a} vs {cond_b})"
+def _suffix(cond_a: str, cond_b: str) -> str:
+    """" (label A vs label B)" for two conditions, "" for one (the verdict opens with its label:
+    :func:`_condition_prefix`); labels from :func:`benchmark.leaderboard.protocols.condition_label`."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    return "" if cond_a == cond_b else f" ({condition_label(cond_a)} vs {condition_label(cond_b)})"
+
+
+def _condition_prefix(result: dict) -> str:
+    """"daylight: " where both runs share a condition (what it physically is), else ""."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    cond = result["a"]["condition"]
+    return f"{condition_label(cond)}: " if cond and cond == result["b"]["condition"] else ""
 
 
 def _interval_excludes_zero(row: dict) -> bool:
@@ -342,8 +402,8 @@ def blind_from(result: dict) -> float | None:
     return start
 
 
-def _blind_text(result: dict, when: str) -> str:
-    """"; both blind at night beyond 25 m (at every distance beyond it, neither camera found 3
+def _blind_text(result: dict) -> str:
+    """"; both blind beyond 25 m (at every distance beyond it, neither camera found 3
     of the 10 cars ...)", or "" (blind at every distance: :func:`verdict` says it alone)."""
     start = blind_from(result)
     if start is None:
@@ -351,7 +411,7 @@ def _blind_text(result: dict, when: str) -> str:
     rows = sorted(result["per_distance"], key=lambda r: r["distance_m"])
     before = [r["distance_m"] for r in rows if r["distance_m"] < start]
     row = next(r for r in rows if r["distance_m"] == start)
-    return f"; both blind{when} beyond {before[-1]:g} m (at every distance beyond it, {_found_rule_text(result, row)})"
+    return f"; both blind beyond {before[-1]:g} m (at every distance beyond it, {_found_rule_text(result, row)})"
 
 
 def _found_rule_text(result: dict, row: dict) -> str:
@@ -376,20 +436,20 @@ def _unbacked_text(result: dict) -> str:
 
 
 def verdict(result: dict) -> str:
-    """The plain-language line: "A detects cars 18 ± 7 m farther than B by day (95 %: 5–31 m)",
-    "... AP differs at 50 m ...", or "both blind at night beyond 25 m" (see the module docstring)."""
+    """The plain-language line: "daylight: A detects cars 18 ± 7 m farther than B (95 %: 5–31 m)",
+    "... AP differs at 50 m ...", or "...: both blind beyond 25 m", opening with what the
+    condition physically is (see the module docstring)."""
     if result.get("sample_too_small"):
         return sample_too_small_text(result["environments_per_distance"])
     a, b = result["a"], result["b"]
-    when, _ = _when(a["condition"], b["condition"])
-    when = f" {when}" if when else ""
+    prefix = _condition_prefix(result)
     rows = result["per_distance"]
     if rows and blind_from(result) == min(r["distance_m"] for r in rows):
         first = min(rows, key=lambda r: r["distance_m"])
         last = max(r["distance_m"] for r in rows)
-        return (f"{a['label']} and {b['label']} are both blind{when} at every measured distance "
+        return (f"{prefix}{a['label']} and {b['label']} are both blind at every measured distance "
                 f"({first['distance_m']:g} to {last:g} m: {_found_rule_text(result, first)}): no difference is called")
-    return _od50_verdict(result) + _unbacked_text(result) + _blind_text(result, when) + _too_few_text(result)
+    return prefix + _od50_verdict(result) + _unbacked_text(result) + _blind_text(result) + _too_few_text(result)
 
 
 def _too_few_text(result: dict) -> str:
@@ -404,8 +464,7 @@ def _too_few_text(result: dict) -> str:
 
 def _od50_verdict(result: dict) -> str:
     a, b, od = result["a"], result["b"], result["delta_od50"]
-    when, suffix = _when(a["condition"], b["condition"])
-    when = f" {when}" if when else ""
+    suffix = _suffix(a["condition"], b["condition"])
     pct = f"{100 * result['confidence_level']:g} %"
     if od["delta_m"] is None:
         resolved = [r for r in result["per_distance"] if _resolved(r)]
@@ -415,23 +474,23 @@ def _od50_verdict(result: dict) -> str:
         tail = (f"AP differs at {where} m"
                 if resolved else "no AP difference resolved at any distance")
         if result.get("delta_ap_range") is not None:
-            return _range_verdict(result, od_a, od_b, when + suffix, tail, pct)
+            return _range_verdict(result, od_a, od_b, suffix, tail, pct)
         for first, second in ((a, b), (b, a)):  # a lower bound beats a measured value below it
             if first["censored"] == ">" and not second["censored"] and second["od50_m"] is not None:
                 gap = first["bound_m"] - second["od50_m"]
-                return (f"{first['label']} detects cars farther than {second['label']}{when}{suffix}, by at least "
+                return (f"{first['label']} detects cars farther than {second['label']}{suffix}, by at least "
                         f"{gap:.0f} m (OD50 {format_od50(None, '>', first['bound_m'])} vs {second['od50_m']:.1f} m; "
                         f"a bound, not a measured difference); {tail} ({pct})")
-        return (f"OD50 of {a['label']} is {od_a} and of {b['label']} {od_b}{when}{suffix}: outside the measured distances, "
+        return (f"OD50 of {a['label']} is {od_a} and of {b['label']} {od_b}{suffix}: outside the measured distances, "
                 f"ΔOD50 is not measured; {tail} ({pct})")
     d, sd, (lo, hi) = od["delta_m"], od["sd_m"] or 0.0, od["ci95_m"]
     if not (lo > 0 or hi < 0):
-        return (f"no difference resolved between {a['label']} and {b['label']}{when}{suffix}: "
+        return (f"no difference resolved between {a['label']} and {b['label']}{suffix}: "
                 f"ΔOD50 = {d:+.0f} ± {sd:.0f} m ({pct}: {lo:.0f} to {hi:.0f} m)")
     word, first, second = ("farther", a, b) if d > 0 else ("farther", b, a)
     if d < 0:
         lo, hi = -hi, -lo
-    return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{when}{suffix} "
+    return (f"{first['label']} detects cars {abs(d):.0f} ± {sd:.0f} m {word} than {second['label']}{suffix} "
             f"({pct}: {lo:.0f}–{hi:.0f} m)")
 
 
@@ -484,15 +543,22 @@ def plot_compare(result: dict, out: str | Path) -> Path:
     return out
 
 
-def compare_paths(path_a, path_b, *, cameras=(), condition: str = "day", **kwargs) -> dict:
-    """Resolve A and B (run or sweep folders; ``cameras``: none, one for both, or one each) and compare."""
+def compare_paths(path_a, path_b=None, *, cameras=(), condition: str = "day", reference: str | Path | None = None,
+                  leaderboard_dir: str | Path = "leaderboard", **kwargs) -> dict:
+    """Resolve A and B (run or sweep folders; ``cameras``: none, one for both, or one each) and
+    compare; or A against ``reference``, a leaderboard submission (name or path) under A's condition."""
     cameras = list(cameras)
-    if len(cameras) > 2:
-        raise CompareError(f"--camera: give one (both sides) or two (A then B), got {len(cameras)}")
+    if (path_b is None) == (reference is None):
+        raise CompareError("give B (a run or sweep folder) or --reference (a leaderboard submission), not both")
+    if len(cameras) > (1 if reference is not None else 2):
+        raise CompareError(f"--camera: give one (both sides) or two (A then B), got {len(cameras)}"
+                           if reference is None else "--camera: with --reference give one (A's), or none")
     cam_a = cameras[0] if cameras else None
     cam_b = cameras[-1] if cameras else None
-    return compare_runs(load_side(resolve_run(path_a, cam_a, condition)),
-                        load_side(resolve_run(path_b, cam_b, condition)), **kwargs)
+    a = load_side(resolve_run(path_a, cam_a, condition))
+    b = load_reference(reference, a.condition, leaderboard_dir) if reference is not None else load_side(
+        resolve_run(path_b, cam_b, condition))
+    return compare_runs(a, b, **kwargs)
 
 
 def register(app) -> None:
@@ -505,7 +571,10 @@ def register(app) -> None:
     @app.command()
     def compare(
         a: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
-        b: Annotated[Path, typer.Argument(help="run folder, or sweep folder with --camera")],
+        b: Annotated[Optional[Path], typer.Argument(help="run folder, or sweep folder with --camera (or --reference)")] = None,
+        reference: Annotated[Optional[str], typer.Option(
+            help="instead of B: a leaderboard submission (name, or path to its .json) that ships its detections")] = None,
+        leaderboard: Annotated[Path, typer.Option("--leaderboard", help="leaderboard folder --reference names are in")] = Path("leaderboard"),
         camera: Annotated[Optional[list[str]], typer.Option(
             help="camera in a sweep folder: once for both sides, twice for A then B")] = None,
         condition: Annotated[str, typer.Option(help="condition of the runs in sweep folders")] = "day",
@@ -513,7 +582,8 @@ def register(app) -> None:
         resamples: Annotated[int, typer.Option(min=2, help="bootstrap resamples over environments")] = BOOTSTRAP_RESAMPLES,
         seed: Annotated[int, typer.Option(help="bootstrap seed")] = 0,
     ) -> None:
-        """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict."""
+        """Paired bootstrap (same environments) of ΔAP per distance and ΔOD50 of A − B, with a verdict; B is a
+        run, or --reference, a leaderboard submission paired scene by scene through the detections it ships."""
         from metricscenes.outputs import OutputError, check_output
 
         console, err = Console(), Console(stderr=True)
@@ -521,7 +591,8 @@ def register(app) -> None:
             if out is not None:  # not into a collection, a run, a sweep or the leaderboard
                 check_output(out, "--out")
             with err.status("paired bootstrap"):
-                result = compare_paths(a, b, cameras=camera or (), condition=condition, n_resamples=resamples, seed=seed)
+                result = compare_paths(a, b, cameras=camera or (), condition=condition, reference=reference,
+                                       leaderboard_dir=leaderboard, n_resamples=resamples, seed=seed)
         except (CompareError, OutputError, ValueError, OSError) as exc:
             fail(str(exc).splitlines()[0])
         ra, rb = result["a"], result["b"]

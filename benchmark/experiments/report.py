@@ -13,6 +13,11 @@ car detection (red, with its score). Every image is embedded as base64 PNG and t
 page loads nothing from elsewhere; the figures are also written as PNG and SVG next
 to the page (``figures/``). Liu et al., EI 2023, Figs. 5-7; DESIGN §4.
 
+``references``: a protocol whose reference submissions' AP per distance (the leaderboard's band,
+:mod:`benchmark.leaderboard.band`) the runs are drawn over, "Beside the references", without
+rendering them. Conditions are named by what they physically are
+(:func:`benchmark.leaderboard.protocols.condition_label`) in titles, tables and headings.
+
 Where the cameras differ in focal length the MTF50 axis of the figures is the angular one
 (cycles/mrad in object space, :func:`benchmark.experiments.spm.mtf50_axis`); the captions say
 which axis each figure uses.
@@ -203,7 +208,7 @@ def plot_ap_curves(table: pd.DataFrame, out=None, *, axis: str = "sensor"):
         sns.lineplot(data=data[data["condition"] == condition], x="distance_m", y="ap", hue="camera",
                      hue_order=list(labels.values()), palette=palette, marker="o", ax=ax, legend=ax is axes[0][-1])
         ax.axhline(0.5, color="grey", lw=0.8, ls=":")
-        ax.set(title=condition, xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)", ylim=(-0.02, 1.02))
+        ax.set(title=_label(condition), xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)", ylim=(-0.02, 1.02))
     legend = axes[0][-1].get_legend()
     if legend is not None:
         sns.move_legend(axes[0][-1], "upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7, title="camera (MTF50)")
@@ -238,7 +243,8 @@ def summary_table(table: pd.DataFrame, od50: pd.DataFrame) -> pd.DataFrame:
         "AP range 95 % (m)": [_interval(_num(lo), _num(hi)) for lo, hi in zip(
             _col(rows, "ap_range_ci95_lo_m", np.nan), _col(rows, "ap_range_ci95_hi_m", np.nan))],
     }, index=rows.index)
-    return out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+    out = out.join(ap.map(lambda v: f"{v:.3f}")).reset_index()
+    return out.assign(condition=out["condition"].map(_label))
 
 
 def working_point_table(runs: dict[tuple[str, str], Path]) -> pd.DataFrame | None:
@@ -249,7 +255,7 @@ def working_point_table(runs: dict[tuple[str, str], Path]) -> pd.DataFrame | Non
     for (camera, condition), folder in runs.items():
         per = _working_point(Path(folder))
         if per:
-            rows.append({"camera": camera, "condition": condition,
+            rows.append({"camera": camera, "condition": _label(condition),
                          **{f"{d:g} m": f"{m:.2f} / {fp:.2f}" for d, (m, fp) in sorted(per.items())}})
     return pd.DataFrame(rows).fillna("–") if rows else None
 
@@ -326,10 +332,60 @@ def image_strips(runs: dict[tuple[str, str], Path], table: pd.DataFrame) -> list
     return [{"distance_m": d, "condition": c, "images": v} for (d, c), v in sorted(strips.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], 99)))]
 
 
-def report(results_dir, out=None) -> Path:
+def _label(condition: str) -> str:
+    """What a condition physically is (:func:`benchmark.leaderboard.protocols.condition_label`)."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    return condition_label(condition)
+
+
+def plot_over_band(table: pd.DataFrame, band, protocol, out=None):
+    """The runs' AP vs distance (a line per camera) over the references' band (lowest to highest
+    AP shaded, median dashed), one panel per condition both hold; ``band``:
+    :func:`benchmark.leaderboard.band.reference_band`. ValueError where they share no condition."""
+    bands = [b for b in band if b.condition in set(table["condition"])]
+    if not bands:
+        raise ValueError(f"--references {protocol.name}: its references hold no condition of these runs "
+                         f"(they hold {', '.join(b.condition for b in band)}; the runs {', '.join(dict.fromkeys(table['condition']))})")
+    fig, axes = plt.subplots(1, len(bands), figsize=(4.6 * len(bands) + 1.6, 3.8), squeeze=False, sharey=True,
+                             constrained_layout=True)
+    cameras = list(dict.fromkeys(table["camera"]))
+    for ax, b in zip(axes[0], bands):
+        ax.fill_between(b.distances_m, b.lo, b.hi, color="#9ecae1", alpha=0.7, lw=0,
+                        label=f"{b.n} references: lowest to highest")
+        ax.plot(b.distances_m, b.median, "--", color="#08519c", lw=1.2, label="references: median")
+        part = table[table["condition"] == b.condition]
+        for k, camera in enumerate(cameras):
+            rows = part[part["camera"] == camera].sort_values("distance_m")
+            if not rows.empty:
+                ax.plot(rows["distance_m"], rows["ap"], "o-", color=f"C{(k + 1) % 10}", lw=1.8, label=camera)
+        ax.axhline(0.5, color="grey", lw=0.8, ls=":")
+        ax.set(title=protocol.label(b.condition), xlabel="distance (m)", ylabel="AP (COCO @[.5:.95], car)",
+               ylim=(-0.02, 1.02))
+    axes[0][-1].legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7)
+    if out is not None:
+        spm.save_figure(fig, out)
+    return fig
+
+
+def _references_figure(table: pd.DataFrame, meta: dict, references: str, leaderboard_dir, fig_dir: Path) -> tuple:
+    from benchmark.leaderboard.band import references_of
+
+    manifest = meta.get("collection", {}).get("manifest_sha256")
+    protocol, band = references_of(references, leaderboard_dir, manifest_sha256=manifest)
+    n = max(b.n for b in band)
+    caption = (f"AP vs distance of these runs over the {n} reference submissions of {protocol.name} "
+               f"({protocol.references}, from {leaderboard_dir}) on the same collection: shaded from their lowest to "
+               "their highest AP, dashed their median (from the AP per distance they submitted; nothing rendered "
+               "again); dotted: AP 0.5.")
+    return ("Beside the references", caption, plot_over_band(table, band, protocol, fig_dir / f"references_{protocol.name}"))
+
+
+def report(results_dir, out=None, *, references: str | None = None, leaderboard_dir="leaderboard") -> Path:
     """Write ``report.html`` and its figures; returns the page's path. ``results_dir``: a
     sweep or run folder (the page goes there by default), or a list of them (:func:`load_many`;
-    ``out`` required)."""
+    ``out`` required). ``references``: a protocol of the leaderboard in ``leaderboard_dir``
+    whose references' band the runs are drawn over (:func:`plot_over_band`)."""
     folders = [Path(p) for p in results_dir] if isinstance(results_dir, (list, tuple)) else [Path(results_dir)]
     if out is None and len(folders) > 1:
         raise ValueError(f"{len(folders)} results folders: name the page with --out (e.g. --out report/report.html)")
@@ -338,7 +394,8 @@ def report(results_dir, out=None) -> Path:
     fig_dir = out.parent / "figures"
     is_lux = table["condition"].map(parse_illuminance_condition).notna()
     main, main_od50 = table[~is_lux], od50[~od50["condition"].map(parse_illuminance_condition).notna()]
-    figures = _main_figures(main, main_od50, fig_dir) if not main.empty else []
+    beside = [_references_figure(main, meta, references, leaderboard_dir, fig_dir)] if references else []
+    figures = beside + (_main_figures(main, main_od50, fig_dir) if not main.empty else [])
     lux = illuminance_table(table)
     for camera, part in lux.groupby("camera", sort=False):
         if part["illuminance_lux"].nunique() >= 2 and part["distance_m"].nunique() >= 2:
@@ -373,7 +430,7 @@ def report(results_dir, out=None) -> Path:
                         "<span style='color:#e00'>red</span>: best car detection and its score.</p>")
         for s in strips:
             cells = "".join(_thumb_html(i) for i in s["images"])
-            sections.append(f"<h3>{s['distance_m']:g} m · {html.escape(s['condition'])}</h3><div class='strip'>{cells}</div>")
+            sections.append(f"<h3>{s['distance_m']:g} m · {html.escape(_label(s['condition']))}</h3><div class='strip'>{cells}</div>")
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(_page(meta, "\n".join(sections)), encoding="utf-8")
     summary.to_csv(out.parent / "report_table.csv", index=False)

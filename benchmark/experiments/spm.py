@@ -74,6 +74,13 @@ def mtf50_axis_text(table: pd.DataFrame, axis: str) -> str:
     return "MTF50 in cycles/mm on the sensor"
 
 
+def _label(condition: str) -> str:
+    """What a condition physically is (:func:`benchmark.leaderboard.protocols.condition_label`)."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    return condition_label(condition)
+
+
 def save_figure(fig, out) -> list[Path]:
     """Write ``out.png`` (150 dpi) and ``out.svg``; returns the two paths."""
     out = Path(out)
@@ -166,7 +173,7 @@ def spm_mtf50(table: pd.DataFrame, out=None, *, conditions=None, mark_mtf50: flo
         filled = _draw_map(ax, gx, gy, gz, part["distance_m"], part[column])
         if mark_mtf50 is not None and _mark_od50(ax, gx, gy, gz, mark_mtf50) is not None:
             ax.legend(loc="upper right", fontsize=7)
-        ax.set(title=f"{condition}", xlabel="distance (m)", ylabel=label)
+        ax.set(title=_label(condition), xlabel="distance (m)", ylabel=label)
     fig.colorbar(filled, ax=axes[0].tolist(), label="AP (COCO @[.5:.95], car)")
     if title:
         fig.suptitle(title)
@@ -254,7 +261,8 @@ def od50_vs_mtf50(od50_table: pd.DataFrame, out=None, *, conditions=None, title:
         colour = CONDITION_COLOURS.get(condition, f"C{k}")
         few = _too_few(fitted)
         slope, intercept = fit_line(fitted.loc[~few, x], fitted.loc[~few, "od50_m"])
-        label = f"{condition}: slope {slope:.2f} m per {x_unit}" if np.isfinite(slope) else f"{condition}: no fit"
+        name = _label(condition)
+        label = f"{name}: slope {slope:.2f} m per {x_unit}" if np.isfinite(slope) else f"{name}: no fit"
         if few.any():  # (the page says why beside the table: benchmark.scoring.sample_too_small_text)
             label += f" ({few.sum()} from too few environments: not fitted)"
         if len(outside) and censored:

@@ -8,6 +8,10 @@ submission's ``created_at``. OD50 and AP range from fewer than
 (:func:`metricscenes.files.write_atomic`) and only after every submission
 has validated, so a bad submission or an interrupted render leaves the old table intact.
 
+Columns and figures name each condition by what it physically is (:meth:`Protocol.label`). Under
+each protocol's table the references' band (:mod:`benchmark.leaderboard.band`): inline SVG in the
+page, ``references-<protocol>.svg`` beside README.md.
+
 The HTML page is self-contained: inline CSS and a small vanilla-JS sorter, allowed by a
 Content-Security-Policy that names their sha256 and nothing else (no external URLs).
 Clicking a column header sets ``#sort=<key>`` (``#sort=-<key>``: descending) and the
@@ -25,6 +29,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from benchmark.leaderboard.band import band_svg, reference_band
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.scoring.sample import few_footnote
 from benchmark.leaderboard.validate import SUBMISSIONS, duplicate_problem, read_submission_file, validate_submission
@@ -49,19 +54,29 @@ class Column:
 
 def load_submissions(leaderboard_dir: str | Path, protocols: dict[str, Protocol] | None = None) -> list[dict]:
     """Every ``submissions/*.json``, validated (first failure raises :class:`SubmissionError`), by name;
-    two files of one system (or sharing detections) are refused too: one row per system."""
+    two files of one system (or sharing detections) are refused too: one row per system. Each
+    one's shipped detections must be there with their sha256 (AP is recomputed by ``submit
+    --check``, not at every render), or the file pinned as made before detections shipped."""
+    import warnings
+
     from benchmark.leaderboard.schema import SubmissionError
+    from benchmark.leaderboard.validate import NoDetectionsWarning, check_shipped
 
     folder = Path(leaderboard_dir) / SUBMISSIONS
     protocols = load_protocols(leaderboard_dir) if protocols is None else protocols
     out = []
-    for path in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+    paths = sorted(folder.glob("*.json")) if folder.is_dir() else []
+    for path in paths:
         sub = validate_submission(read_submission_file(path), protocols=protocols, source=f"{SUBMISSIONS}/{path.name}")
         for earlier in out:
             problem = duplicate_problem(sub, earlier, f"{earlier['name']}.json")
             if problem:
                 raise SubmissionError(f"{SUBMISSIONS}/{path.name}: {problem}")
         out.append(sub)
+    for path, sub in zip(paths, out):  # then what ships beside each (files, not fields: after every field is known good)
+        with warnings.catch_warnings():  # a pinned reference is accepted silently here; --check says so
+            warnings.simplefilter("ignore", NoDetectionsWarning)
+            check_shipped(sub, path, protocols, recompute=False, source=f"{SUBMISSIONS}/{path.name}")
     return out
 
 
@@ -161,14 +176,15 @@ def _num(value, fmt: str) -> tuple[str, str]:
     return ("", "–") if value is None else (repr(float(value)), format(value, fmt))
 
 
-def _title(condition: str) -> str:
-    """A condition as a column header: "Night regulation" (a space lets the header wrap)."""
-    return condition.replace("_", " ").capitalize()
+def _title(protocol: Protocol, condition: str) -> str:
+    """A condition as a column header: what it physically is, capitalised ("Daylight")."""
+    label = protocol.label(condition)
+    return label[:1].upper() + label[1:]
 
 
 def columns(protocol: Protocol) -> list[Column]:
-    od50 = [Column(f"{c}_od50", f"{_title(c)} OD50 (m)", "num") for c in protocol.conditions]
-    ranges = [Column(f"{c}_ap_range", f"{_title(c)} AP range (m)", "num") for c in RANKED_CONDITIONS
+    od50 = [Column(f"{c}_od50", f"{_title(protocol, c)} OD50 (m)", "num") for c in protocol.conditions]
+    ranges = [Column(f"{c}_ap_range", f"{_title(protocol, c)} AP range (m)", "num") for c in RANKED_CONDITIONS
               if c in protocol.conditions]
     return [Column("rank", "#", "num"), Column("system", "System", "str"), Column("camera", "Camera", "str"), *od50, *ranges,
             Column("mtf50", "MTF50 (cy/mm)", "num"), Column("mtf50_mrad", "MTF50 (cy/mrad)", "num"),
@@ -222,6 +238,32 @@ def _by_protocol(submissions: list[dict], protocols: dict[str, Protocol]) -> lis
     return [(p, ranked([s for s in submissions if s["collection"]["protocol"] == name])) for name, p in protocols.items()]
 
 
+_SAFE_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
+
+
+def band_file(protocol: Protocol) -> str | None:
+    """``references-<protocol>.svg``, the band's file beside README.md (None: a name unfit for a file)."""
+    return f"references-{protocol.name}.svg" if _SAFE_FILE.fullmatch(protocol.name) else None
+
+
+def band_figures(submissions: list[dict], protocols: dict[str, Protocol]) -> dict[str, str]:
+    """{protocol name: SVG of its references' band} for the protocols that have references."""
+    out = {}
+    for name, protocol in protocols.items():
+        band = reference_band(submissions, protocol)
+        if band:
+            out[name] = band_svg(band, protocol)
+    return out
+
+
+def _band_caption(submissions: list[dict], protocol: Protocol) -> tuple[str, str]:
+    """(text, command) under the band figure."""
+    n = sum(1 for s in submissions if s["collection"]["protocol"] == protocol.name and protocol.is_reference(s["name"]))
+    return (f"AP vs distance of the {n} references ({protocol.references}), per condition: shaded from the lowest to "
+            "the highest AP, the line their median; dotted: AP 0.5. A run over it:",
+            f"benchmark report RUN --references {protocol.name}")
+
+
 # Markdown's inline syntax: a backslash before any of these shows it as itself (CommonMark
 # "backslash escapes"), as html.escape does for the page; "|" would end the table cell.
 _MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>|~&!#])")
@@ -233,18 +275,27 @@ def _md(text: str) -> str:
     return _MD_SPECIAL.sub(r"\\\1", _MD_BREAK.sub(" ", text))
 
 
+def _ranked_labels(protocols: dict[str, Protocol]) -> tuple[str, str]:
+    """What the two ranked conditions (day, night) physically are, for the page's prose."""
+    from benchmark.leaderboard.protocols import condition_label
+
+    labels = next(iter(protocols.values())).labels if protocols else None
+    return tuple(condition_label(c, labels) for c in RANKED_CONDITIONS)  # type: ignore[return-value]
+
+
 def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
     latest = max((s["created_at"] for s in submissions), default=None)
+    day, night = (_md(t) for t in _ranked_labels(protocols))
     lines = [
         "# metricscenes leaderboard", "",
         "<!-- Generated by `benchmark leaderboard` from submissions/; edits are overwritten. -->", "",
         "How far away does a camera system (camera + ISP + detector) still find a car? Each table ranks",
-        "systems by **daylight OD50**, the distance at which COCO AP of the car falls to 0.5 (Liu et al.,",
-        f"EI 2023), then by night OD50. ± is the bootstrap SD over environments ({_resamples(submissions)}).",
+        f"systems by the OD50 in **{day}**, the distance at which COCO AP of the car falls to 0.5 (Liu et al.,",
+        f"EI 2023), then by the OD50 in **{night}**. ± is the bootstrap SD over environments ({_resamples(submissions)}).",
         "Censored OD50s show a bound: \\> 200 when AP has not yet fallen to 0.5 at the farthest distance (a",
         "lower bound; ranked above every measured OD50), \\< 25 when AP is below 0.5 already at the nearest",
         "(ranked below every measured OD50); among themselves both rank by the **AP range**, the area under",
-        "AP vs distance in metres (defined for every camera; shown for day and night). An extrapolated OD50",
+        "AP vs distance in metres (defined for every camera; shown for the two ranked conditions). An extrapolated OD50",
         "is neither shown nor ranked by, and no tie is broken by AP at one distance. MTF50 is measured on the camera's",
         "simulated slanted edge (ISO 12233), or the paper's published group where marked, in cycles/mm on",
         "the sensor and in cycles/mrad in object space (× focal length / 1000): only the angular figure",
@@ -253,6 +304,7 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
         *([_md(few_footnote()) + ".", ""] if _few(submissions) else []),
         f"{len(submissions)} submission(s)" + (f"; newest {latest}." if latest else "."), "",
     ]  # fmt: skip
+    bands = band_figures(submissions, protocols)
     for protocol, subs in _by_protocol(submissions, protocols):
         cols = columns(protocol)
         lines += [f"## {_md(protocol.name)}", "", f"{_md(protocol.description)}.", ""]
@@ -266,6 +318,10 @@ def render_markdown(submissions: list[dict], protocols: dict[str, Protocol]) -> 
             cells["system"] = ("", f"[{_md(sub['name'])}](submissions/{sub['name']}.json)")
             lines.append("| " + " | ".join(_md(cells[c.key][1]) if c.key != "system" else cells[c.key][1] for c in cols) + " |")
         lines.append("")
+        if protocol.name in bands and band_file(protocol):
+            text, command = _band_caption(submissions, protocol)  # (band_file: a protocol name safe in a code span)
+            lines += [f"![references' AP vs distance, {_md(protocol.name)}]({band_file(protocol)})", "",
+                      f"{_md(text)} `{command}`.", ""]
     lines += [
         "## Reproduce the reference submissions", "",
         "The 13 paper cameras with YOLOv5n on each protocol's collection (all conditions):", "",
@@ -293,17 +349,20 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
     style, script = _asset("leaderboard.css"), _asset("leaderboard.js")
     csp = f"default-src 'none'; style-src {_csp_hash(style)}; script-src {_csp_hash(script)}; base-uri 'none'; form-action 'none'"
     latest = max((s["created_at"] for s in submissions), default=None)
+    day, night = _ranked_labels(protocols)
+    bands = band_figures(submissions, protocols)
     out = [
         "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
         f'<meta http-equiv="Content-Security-Policy" content="{esc(csp)}">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
         "<title>metricscenes leaderboard</title>", f"<style>{style}</style>", "</head>", "<body>",
         "<h1>metricscenes leaderboard</h1>",
-        "<p>Ranked by daylight OD50 (distance at which COCO AP of the car falls to 0.5), then night OD50. "
+        f"<p>Ranked by the OD50 in {esc(day)} (distance at which COCO AP of the car falls to 0.5), then by the OD50 in "
+        f"{esc(night)}. "
         f"± is the bootstrap SD over environments ({esc(_resamples(submissions))}). &gt; 200: AP has not yet fallen "
         "to 0.5 at the farthest distance (a lower bound; ranked above every measured OD50); &lt; 25: below 0.5 already "
         "at the nearest (ranked below every measured OD50); among themselves both rank by the AP range, the area under "
-        "AP vs distance in metres (defined for every camera; shown for day and night); no tie is broken by AP at one "
+        "AP vs distance in metres (defined for every camera; shown for the two ranked conditions); no tie is broken by AP at one "
         "distance. MTF50 in cycles/mm on the sensor and in cycles/mrad in object space (× focal length / 1000): "
         "only the angular figure compares cameras whose focal lengths differ. Click a column to sort.</p>",
         *([f'<p class="meta">{esc(few_footnote())}.</p>'] if _few(submissions) else []),
@@ -328,7 +387,12 @@ def render_html(submissions: list[dict], protocols: dict[str, Protocol]) -> str:
                 body = f'<a href="submissions/{esc(sub["name"])}.json">{esc(text)}</a>' if c.key == "system" else esc(text)
                 tds.append(f'<td data-v="{esc(value)}"{_cell_class(c)}>{body}</td>')
             out.append(f'<tr data-name="{esc(sub["name"])}">' + "".join(tds) + "</tr>")
-        out += ["</tbody>", "</table></div>", "</section>"]
+        out += ["</tbody>", "</table></div>"]
+        if protocol.name in bands:
+            out += ['<figure class="band">', bands[protocol.name].rstrip("\n"),
+                    "<figcaption>{} <code>{}</code>.</figcaption>".format(*map(esc, _band_caption(submissions, protocol))),
+                    "</figure>"]
+        out.append("</section>")
     out += [f"<script>{script}</script>", "</body>", "</html>", ""]
     return "\n".join(out)
 
@@ -344,9 +408,18 @@ def _cell_class(column: Column) -> str:
 
 
 def render_leaderboard(leaderboard_dir: str | Path = "leaderboard") -> tuple[Path, Path]:
-    """Validate every submission, then write ``README.md`` and ``index.html`` atomically; returns their paths."""
+    """Validate every submission, then write the references' band figures, ``README.md`` and
+    ``index.html`` atomically (a band file no protocol draws any more is removed); returns the
+    paths of README.md and index.html."""
     leaderboard_dir = Path(leaderboard_dir)
     protocols = load_protocols(leaderboard_dir)
     submissions = load_submissions(leaderboard_dir, protocols)
     readme, page = render_markdown(submissions, protocols), render_html(submissions, protocols)
+    figures = {band_file(protocols[name]): svg for name, svg in band_figures(submissions, protocols).items()
+               if band_file(protocols[name])}
+    for name, svg in sorted(figures.items()):
+        write_atomic(leaderboard_dir / name, svg)
+    for stale in sorted(leaderboard_dir.glob("references-*.svg")):
+        if stale.name not in figures:
+            stale.unlink()
     return write_atomic(leaderboard_dir / "README.md", readme), write_atomic(leaderboard_dir / "index.html", page)

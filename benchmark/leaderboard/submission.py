@@ -6,7 +6,10 @@ one camera system: every run of one camera (one run per condition), with the sam
 camera spec, detector, collection and scoring backend. Before anything is written each
 run's detections file is checked against its recorded sha256, AP is recomputed from it,
 and OD50's bootstrap SD over environments is computed (:func:`benchmark.scoring.bootstrap_od50`)
-unless the run already carries it with the same resampling settings.
+unless the run already carries it with the same resampling settings. Each condition's
+detections and ground truth are packed (:mod:`benchmark.leaderboard.detections`), AP is
+recomputed from the pack too, and :func:`write_submission` writes the packs beside the JSON,
+so that ``submit --check`` recomputes every AP from what ships.
 """
 
 from __future__ import annotations
@@ -22,15 +25,30 @@ from benchmark.result_files import (
     RESULTS_FORMAT, DetectorRecord, Od50CacheKey, ResultsFileError, RunFolder, read_od50_cache, read_results,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, Od50Bootstrap
+from benchmark.leaderboard.detections import pack_path, pack_run, recompute, sha256_bytes, unpack
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
-from benchmark.leaderboard.validate import MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, check_name, check_not_duplicate, validate_submission, verify_detections
+from benchmark.leaderboard.validate import (
+    MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, canonical_text, check_name, check_not_duplicate,
+    validate_submission, verify_detections,
+)
 from metricscenes.files import sha256_file, write_atomic
 
 N_RESAMPLES = BOOTSTRAP_RESAMPLES  # the one default (benchmark.scoring.bootstrap)
 
 
 Run = RunFolder  # one run folder and its parsed results.json
+
+
+class Submission(dict):
+    """A built submission: its JSON fields, and ``packs``, the detections files it ships
+    ({condition: gzip bytes}; not part of the JSON), which :func:`write_submission` writes beside it."""
+
+    packs: dict[str, bytes]
+
+    def __init__(self, fields: dict, packs: dict[str, bytes]):
+        super().__init__(fields)
+        self.packs = dict(packs)
 
 
 def find_runs(results_dir: str | Path) -> list[Run]:
@@ -116,8 +134,10 @@ def _cached_bootstrap(folder: Path, detections_sha256: str, n_resamples: int, se
     return stored.od50 if stored.key == key else None
 
 
-def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) -> dict:
-    """One condition of a submission from a run folder: verified AP, OD50, bootstrap SD."""
+def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0, packs: dict | None = None) -> dict:
+    """One condition of a submission from a run folder: verified AP, OD50, bootstrap SD, and the
+    sha256 of its packed detections (:func:`benchmark.leaderboard.detections.pack_run`), whose
+    bytes go into ``packs[condition]`` where given."""
     from benchmark.scoring import bootstrap_od50, od50
 
     res = run.results
@@ -128,6 +148,12 @@ def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) 
             raise SubmissionError(f"{run.folder}: {p.name} is missing (needed to verify AP and bootstrap OD50)")
     if sha256_file(det_path) != res.detections_sha256:
         raise SubmissionError(f"{det_path}: sha256 differs from results.json's detections_sha256 (file changed?)")
+    try:
+        packed = pack_run(run)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise SubmissionError(f"{run.folder}: cannot pack its detections ({type(exc).__name__}: {exc})".splitlines()[0]) from None
+    if packs is not None:
+        packs[run.condition] = packed
     entry = {
         "per_distance": [
             {"distance_m": r.distance_m, "ap": r.ap, "ap50": r.ap50, "n_images": r.n_images}
@@ -136,6 +162,7 @@ def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0) 
         "od50_m": None,  # recomputed below from the AP curve, as the validator does
         "seed": res.seed,
         "detections_sha256": res.detections_sha256,
+        "shipped_detections_sha256": sha256_bytes(packed),
     }
     entry["od50_m"] = _none_if_not_finite(od50([r["distance_m"] for r in entry["per_distance"]], [r["ap"] for r in entry["per_distance"]]))
     probe = {"collection": res.collection.model_dump(), "scoring": {"backend": res.scoring_backend},
@@ -190,6 +217,7 @@ def build_submission(
     spec = camera_from_dump(first.camera.spec, source=f"{runs[0].folder}/results.json camera.spec")
     mtf50, mtf50_source = _mtf50(spec, measure_mtf)
     det = first.detector
+    packs: dict[str, bytes] = {}
     submission = {
         "format": SUBMISSION_FORMAT,
         "name": name,
@@ -206,7 +234,7 @@ def build_submission(
                        "manifest_sha256": first.collection.manifest_sha256},
         "scoring": {"backend": first.scoring_backend, "category_id": 3,
                     "bootstrap_resamples": n_resamples, "bootstrap_seed": seed},
-        "conditions": {run.condition: condition_entry(run, n_resamples=n_resamples, seed=seed) for run in runs},
+        "conditions": {run.condition: condition_entry(run, n_resamples=n_resamples, seed=seed, packs=packs) for run in runs},
     }  # fmt: skip
     if notes:
         submission["notes"] = notes
@@ -214,7 +242,11 @@ def build_submission(
         submission["software"] = {"versions": first.numerics["versions"], "isa_class": first.numerics["isa_class"]}
     if spec.sha256() != first.camera.spec_sha256:
         raise SubmissionError(f"{runs[0].folder}/results.json: camera.spec_sha256 does not match its spec")
-    return validate_submission(submission, protocols=protocols, source=name)
+    validate_submission(submission, protocols=protocols, source=name)
+    for cname, data in packs.items():  # what ships gives what is claimed, as --check will find
+        recompute(submission, cname, unpack(data, expected_sha256=submission["conditions"][cname]["shipped_detections_sha256"],
+                                            source=f"{name}.detections/{cname}.json.gz"), source=name)
+    return Submission(submission, packs)
 
 
 def software_differences(submission: dict) -> list[str]:
@@ -237,15 +269,43 @@ def software_differences(submission: dict) -> list[str]:
 
 def dumps_submission(submission: dict) -> str:
     """Canonical text of a submission: sorted keys, 1-space indent, trailing newline."""
-    return json.dumps(submission, indent=1, sort_keys=True, ensure_ascii=False, allow_nan=False) + "\n"
+    return canonical_text(submission)
 
 
-def write_submission(submission: dict, leaderboard_dir: str | Path = "leaderboard") -> Path:
-    """Validate against the leaderboard (protocols, duplicates), then write ``submissions/<name>.json`` atomically."""
-    leaderboard_dir = Path(leaderboard_dir)
-    validate_submission(submission, protocols=load_protocols(leaderboard_dir), source=submission.get("name", "submission"))
-    check_not_duplicate(submission, leaderboard_dir)
+def _packs_of(submission: dict, packs: dict[str, bytes] | None) -> dict[str, bytes]:
+    """The detections files of every condition, each matching its ``shipped_detections_sha256``."""
+    packs = packs if packs is not None else getattr(submission, "packs", {})
+    name = submission.get("name", "submission")
+    for cname, cond in sorted(submission["conditions"].items()):
+        digest = cond.get("shipped_detections_sha256")
+        if digest is None:
+            raise SubmissionError(f"{name}: carries no detections: its AP cannot be recomputed (build it with "
+                                  "`benchmark submit` from its runs)")
+        if cname not in packs or sha256_bytes(packs[cname]) != digest:
+            raise SubmissionError(f"{name}: conditions.{cname}: no detections file with its shipped_detections_sha256 "
+                                  f"{digest[:12]}... to write (build it with `benchmark submit` from its runs)")
+    return {c: packs[c] for c in submission["conditions"]}
+
+
+def save_submission(submission: dict, folder: str | Path, packs: dict[str, bytes] | None = None) -> Path:
+    """Write ``<name>.detections/<condition>.json.gz`` and then ``<name>.json`` into ``folder``,
+    each atomically (a JSON never names files not yet there); no validation. ``packs``: the
+    detections files, by default the built submission's own."""
+    folder = Path(folder)
+    path = folder / f"{check_name(submission['name'])}.json"
     text = dumps_submission(submission)
     if len(text.encode("utf-8")) > MAX_SUBMISSION_BYTES:
         raise SubmissionError(f"{submission['name']}: submission over the 5 MB limit")
-    return write_atomic(leaderboard_dir / SUBMISSIONS / f"{submission['name']}.json", text)
+    for cname, data in sorted(_packs_of(submission, packs).items()):
+        write_atomic(pack_path(path, cname), data)
+    return write_atomic(path, text)
+
+
+def write_submission(submission: dict, leaderboard_dir: str | Path = "leaderboard",
+                     packs: dict[str, bytes] | None = None) -> Path:
+    """Validate against the leaderboard (protocols, duplicates), then write ``submissions/<name>.json``
+    and its detections (:func:`save_submission`)."""
+    leaderboard_dir = Path(leaderboard_dir)
+    validate_submission(submission, protocols=load_protocols(leaderboard_dir), source=submission.get("name", "submission"))
+    check_not_duplicate(submission, leaderboard_dir)
+    return save_submission(submission, leaderboard_dir / SUBMISSIONS, packs)

@@ -17,9 +17,12 @@ protocol's number of environments and its own detections file, and the required 
 are there; AP never exceeds AP50; OD50 follows from the AP curve
 (:func:`benchmark.scoring.od50`) and lies inside its ordered 95 % interval, whose SD is 0
 only if it has no width, none of them above :data:`MAX_OD50_M`; the name is new on the leaderboard, and so are the system (camera
-spec, detector, collection: a reproduction is not a second row) and its detections; and,
-given the detections file and ground truth, AP recomputed with
-:func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
+spec, detector, collection: a reproduction is not a second row) and its detections; every
+condition ships its detections beside the file (:mod:`benchmark.leaderboard.detections`), whose
+sha256 matches and from which AP, AP50, OD50 and the counts are recomputed
+(:func:`check_shipped`), unless the protocol pins the file as made before detections shipped
+(accepted with a :class:`NoDetectionsWarning`); and, given a run's detections file and ground
+truth, AP recomputed with :func:`benchmark.scoring.ap_by_distance` equals the claimed AP within 1e-6.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import hashlib
 import json
 import math
 import re
+import warnings
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -47,6 +51,21 @@ CLOCK_TOLERANCE = timedelta(days=1)  # created_at may be this far ahead of the c
 EARLIEST_CREATED_AT = datetime(2023, 1, 1, tzinfo=timezone.utc)  # the protocol's paper (Liu et al., EI 2023)
 MAX_OD50_M = 1e9  # beyond any extrapolated OD50 of a real AP curve (the committed ones reach 3e5 m)
 SUBMISSIONS = "submissions"
+
+
+class NoDetectionsWarning(UserWarning):
+    """A submission made before detections shipped, accepted without them: its AP is not recomputed."""
+
+
+def canonical_text(data: dict) -> str:
+    """Canonical text of a submission: sorted keys, 1-space indent, trailing newline (how files are written)."""
+    return json.dumps(data, indent=1, sort_keys=True, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+def canonical_sha256(data: dict) -> str:
+    """sha256 of a submission's canonical text: what ``made_before_detections`` pins, so that an
+    edited file is no longer the one accepted."""
+    return hashlib.sha256(canonical_text(data).encode("utf-8")).hexdigest()
 
 
 def check_name(name: str) -> str:
@@ -479,6 +498,57 @@ def verify_detections(data: dict, detections: list[str | Path], groundtruth: str
     return verified
 
 
+def check_shipped(data: dict, path: str | Path, protocols: dict[str, Protocol], *, recompute: bool = True,
+                  source: str | None = None) -> list[str]:
+    """The conditions whose shipped detections (``<name>.detections/<condition>.json.gz`` beside
+    ``path``) match their sha256 and, with ``recompute``, give every AP, AP50, image count, OD50
+    and environment count the submission claims (:func:`benchmark.leaderboard.detections.recompute`);
+    one line refuses the first that does not. A submission that ships none is refused ("carries
+    no detections") unless its protocol's ``made_before_detections`` pins this very file (its
+    canonical sha256: an edited copy is refused): then [] and a :class:`NoDetectionsWarning`."""
+    from benchmark.leaderboard.detections import pack_path, read_pack, recompute as recompute_pack
+
+    path = Path(path)
+    source = source or path.name
+    protocol = protocols[data["collection"]["protocol"]]
+    shipped = {c: cond.get("shipped_detections_sha256") for c, cond in sorted(data["conditions"].items())}
+    if not any(shipped.values()):
+        pinned = protocol.made_before_detections.get(data["name"])
+        if pinned is not None and pinned == canonical_sha256(data):
+            warnings.warn(NoDetectionsWarning(
+                f"{source} was made before detections shipped (protocol {protocol.name!r}, made_before_detections): "
+                "its AP is accepted as published, not recomputed, and compare against it is refused "
+                "(docs/leaderboard.md, \"Where the references' detections come from\")"), stacklevel=2)
+            return []
+        edited = " (and it is not the file pinned as made before detections shipped: edited?)" if pinned else ""
+        raise SubmissionError(f"{source}: carries no detections: its AP cannot be recomputed{edited}; "
+                              "`benchmark submit` writes them beside the file")
+    missing = [c for c, digest in shipped.items() if not digest]
+    if missing:
+        raise SubmissionError(f"{source}: conditions.{missing[0]} carries no detections (no shipped_detections_sha256): "
+                              "its AP cannot be recomputed")
+    for cname, digest in shipped.items():
+        where = pack_path(path, cname)
+        label = f"{where.parent.name}/{where.name}"
+        if not recompute:  # the checksum alone (rendering): the bytes --check recomputed from
+            _check_checksum(where, digest, label)
+            continue
+        recompute_pack(data, cname, read_pack(where, expected_sha256=digest, source=label), source=source)
+    return list(shipped)
+
+
+def _check_checksum(path: Path, digest: str, label: str) -> None:
+    from benchmark.leaderboard.detections import MAX_PACK_BYTES
+
+    if not path.is_file():
+        raise SubmissionError(f"{label}: no such file (the submission's detections are missing)")
+    if path.stat().st_size > MAX_PACK_BYTES:
+        raise SubmissionError(f"{label}: over the {MAX_PACK_BYTES // (1024 * 1024)} MB limit")
+    actual = sha256_file(path)
+    if actual != digest:
+        raise SubmissionError(f"{label}: sha256 {actual[:12]}... is not the submission's {digest[:12]}... (the file changed)")
+
+
 def check_submission_file(
     path: str | Path,
     *,
@@ -486,12 +556,17 @@ def check_submission_file(
     detections: list[str | Path] = (),
     groundtruth: str | Path | None = None,
 ) -> dict:
-    """Everything ``benchmark submit --check`` does; returns the submission. Touches no file."""
+    """Everything ``benchmark submit --check`` does; returns the submission. Touches no file.
+
+    AP is recomputed from the detections shipped beside ``path`` (:func:`check_shipped`; a
+    submission pinned as made before detections shipped warns with :class:`NoDetectionsWarning`)."""
     path = Path(path)
     data = read_submission_file(path)
-    validate_submission(data, protocols=load_protocols(leaderboard_dir), source=path.name)
+    protocols = load_protocols(leaderboard_dir)
+    validate_submission(data, protocols=protocols, source=path.name)
     if leaderboard_dir is not None:
         check_not_duplicate(data, leaderboard_dir, path=path)
+    check_shipped(data, path, protocols, source=path.name)
     if detections:
         if groundtruth is None:
             raise SubmissionError("--detections needs --groundtruth (the run folder's groundtruth.json)")

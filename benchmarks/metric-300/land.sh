@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Bring what benchmarks/metric-300/chain.sh made under WORK into this checkout, and check it:
 # the tables (docs/data/metric-300), the report's figures (docs/img/metric-300), the 13
-# reference submissions (leaderboard/submissions), every submission `--check`ed, the
+# reference submissions with their detections (leaderboard/submissions), every submission `--check`ed
+# (AP recomputed from the detections it ships; delete metric-300's made_before_detections pins in
+# benchmark/leaderboard/data/protocols.yaml once its references ship theirs), the
 # leaderboard rendered twice and compared byte for byte, the findings tests on the tables,
 # and the markdown of metric-300's tables beside quick's (WORK/results-markdown.md, for
 # docs/results.md). Refuses to start before the chain's tables are all there but day_paper's
@@ -31,15 +33,19 @@ for figure in ap_vs_distance spm_mtf50 od50_vs_mtf50; do
 done
 cp "$WORK"/reports/figures/spm_illuminance_*.png "$IMG/spm_illuminance.png"  # the one luminance camera
 cp "$WORK"/leaderboard/submissions/ref-*-metric-300.json "$LEADERBOARD/submissions/"
+for shipped in "$WORK"/leaderboard/submissions/ref-*-metric-300.detections; do  # each one's detections (docs/leaderboard.md)
+  [ -d "$shipped" ] || { echo "error: $shipped is missing: submit the sweep again (its references ship detections)" >&2; exit 1; }
+  rm -rf "$LEADERBOARD/submissions/$(basename "$shipped")" && cp -r "$shipped" "$LEADERBOARD/submissions/"
+done
 
 for submission in "$LEADERBOARD"/submissions/*.json; do
   benchmark submit --check "$submission" --leaderboard "$LEADERBOARD"
 done
 first=$(mktemp -d)
 benchmark leaderboard --dir "$LEADERBOARD"
-cp "$LEADERBOARD/README.md" "$LEADERBOARD/index.html" "$first/"
+cp "$LEADERBOARD/README.md" "$LEADERBOARD/index.html" "$LEADERBOARD"/references-*.svg "$first/"
 benchmark leaderboard --dir "$LEADERBOARD"
-cmp "$first/README.md" "$LEADERBOARD/README.md" && cmp "$first/index.html" "$LEADERBOARD/index.html"
+for page in "$first"/*; do cmp "$page" "$LEADERBOARD/$(basename "$page")"; done
 echo "leaderboard: two builds byte-identical"
 rm -r "$first"
 
