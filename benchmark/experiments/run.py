@@ -277,6 +277,8 @@ class CollectionSubset:
                                                          for d in self.subset["distances_m"])
 
     def __getattr__(self, name):
+        if name == "_collection":  # not set yet (a copy being unpickled in a sweep's worker)
+            raise AttributeError(name)
         return getattr(self._collection, name)
 
     def scenes(self):
