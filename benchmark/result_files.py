@@ -154,6 +154,7 @@ class RunResults(Record):
     captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
     composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before session 12
     condition_weights: dict[str, dict] | None = None  # a targeted condition: per scene, target and weights (metricscenes.targets)
+    condition_spec: dict | None = None  # a read-time condition: its definition (not in the manifest's hash; in the cache key)
     numerics: dict | None = None  # versions, ISA class and kernels that decided the bytes (metricscenes.numeric_pins)
 
     def ap_curve(self) -> tuple[list[float], list[float]]:

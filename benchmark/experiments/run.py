@@ -122,7 +122,30 @@ def capture_key(camera, condition: str, collection, seed: int) -> dict:
     subset = getattr(collection, "subset", None)
     if subset:
         key["subset"] = subset
+    spec = condition_spec(collection, condition)
+    if spec is not None:  # a read-time condition: its definition is not in the manifest's hash
+        key["condition_spec"] = spec
     return key
+
+
+def condition_spec(collection, condition: str) -> dict | None:
+    """A read-time condition's definition (``Collection.read_time_condition``), None for any
+    other (or for a collection that cannot say: a test double)."""
+    read = getattr(collection, "read_time_condition", None)
+    return None if read is None else read(condition)
+
+
+def read_scene(collection, scene_id: str, condition: str):
+    """A scene under ``condition`` for every camera: its radiance, or for a condition that
+    meets its target at each camera's image plane, its parts and how to weigh them
+    (:class:`benchmark.camera.image_plane.ImagePlaneParts`: each camera its own weights)."""
+    if getattr(collection, "targets_camera", lambda _: False)(condition):
+        from benchmark.camera.image_plane import ImagePlaneParts
+
+        parts = {name: collection.radiance(scene_id, weights, inset_resolution=COMPOSITE)
+                 for name, weights in collection.condition_parts(condition).items()}
+        return ImagePlaneParts(parts, lambda lux, at: collection.camera_weights(scene_id, condition, lux, at))
+    return collection.radiance(scene_id, condition, inset_resolution=COMPOSITE)
 
 
 def results_capture_key(results: RunResults) -> dict:
@@ -134,6 +157,8 @@ def results_capture_key(results: RunResults) -> dict:
         key["camera_geometry"] = results.camera_geometry.model_dump()
     if results.subset is not None:
         key["subset"] = results.subset.model_dump()
+    if results.condition_spec is not None:
+        key["condition_spec"] = results.condition_spec
     return key
 
 
@@ -507,7 +532,7 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
         radiance, read_s = None, 0.0
         if any(run.captures is None and scene.scene_id not in run.done for run in runs):
             t = time.perf_counter()
-            radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
+            radiance = read_scene(collection, scene.scene_id, condition)
             read_s = time.perf_counter() - t
         for k in order:
             runs[k].add(scene, radiance, read_s, record)
@@ -566,6 +591,7 @@ class _CameraRun:
         ``record``: what a targeted condition did in it (None for another condition)."""
         from PIL import Image
 
+        from benchmark.camera.image_plane import ImagePlaneParts
         from benchmark.camera.pipeline import simulate
         from benchmark.coco import coco_category_id
 
@@ -577,6 +603,8 @@ class _CameraRun:
             for detections, found in zip(self.detections, staged["detections"]):
                 detections.extend(found)
             self.exposures[scene.scene_id] = staged["exposure_s"]
+            if staged.get("condition_weights") is not None:  # weights of this camera's own (target_at: camera)
+                self.targeted[scene.scene_id] = staged["condition_weights"]
             if staged["exposure_short_s"] is not None:
                 self.short_exposures[scene.scene_id] = staged["exposure_short_s"]
             return
@@ -584,7 +612,11 @@ class _CameraRun:
         if captures is None:
             timings.seconds["read_radiance"] = timings.seconds.get("read_radiance", 0.0) + read_s
             t = time.perf_counter()
-            capture = simulate(radiance, camera, seed=scene_seed(self.seed, scene.image_id))
+            if isinstance(radiance, ImagePlaneParts):  # its weights are this camera's own
+                capture, self.targeted[scene.scene_id] = radiance.simulate(camera, seed=scene_seed(self.seed,
+                                                                                                   scene.image_id))
+            else:
+                capture = simulate(radiance, camera, seed=scene_seed(self.seed, scene.image_id))
             timings.add("camera", t)
             rgb8, self.exposures[scene.scene_id] = capture.rgb8, capture.exposure_s
             if capture.exposure_short_s is not None:
@@ -593,6 +625,8 @@ class _CameraRun:
             t = time.perf_counter()
             rgb8 = _captured_image(captures[0], scene.scene_id, camera)
             self.exposures[scene.scene_id] = captures[1].exposure_s[scene.scene_id]
+            if record is None and (captures[1].condition_weights or {}).get(scene.scene_id) is not None:
+                self.targeted[scene.scene_id] = captures[1].condition_weights[scene.scene_id]  # the camera's own
             if captures[1].exposure_short_s is not None:
                 self.short_exposures[scene.scene_id] = captures[1].exposure_short_s[scene.scene_id]
             timings.add("read_captures", t)
@@ -627,6 +661,8 @@ class _CameraRun:
         entry = {"scene_id": scene.scene_id, "detections": [d[n:] for d, n in zip(self.detections, found_here)],
                  "exposure_s": self.exposures[scene.scene_id],
                  "exposure_short_s": self.short_exposures.get(scene.scene_id)}
+        if isinstance(radiance, ImagePlaneParts):  # weights that are the camera's own are staged with its scene
+            entry["condition_weights"] = self.targeted[scene.scene_id]
         with open(self.checkpoint, "a") as f:  # after the image: a scene listed here is whole
             f.write(json.dumps(entry) + "\n")
 
@@ -684,6 +720,9 @@ class _CameraRun:
         # (results.json holds the fields set: benchmark.result_files).
         if self.targeted:
             results.condition_weights = self.targeted
+        spec = condition_spec(collection, self.condition)
+        if spec is not None:  # a read-time condition: what defined it (the manifest's hash does not)
+            results.condition_spec = spec
         if geometry is not None:  # a camera that sees a window of the field
             results.camera_geometry = CameraGeometry(**geometry)
         subset = getattr(collection, "subset", None)
