@@ -463,6 +463,18 @@ class Collection:
         """Whether ``condition`` is set by a photometric target (its weights depend on the scene)."""
         return isinstance(self.conditions.get(condition), TargetedCondition)
 
+    def with_read_time_conditions(self, extra: dict) -> "Collection":
+        """This collection with more read-time conditions, given at read time (a program's own
+        variants of a condition: ``benchmark paper-factors``), validated as a manifest's own
+        and refused in one line; the same arrays, hash and caches."""
+        data = self.manifest.model_dump(mode="json")
+        data["read_time_conditions"] = {**(data.get("read_time_conditions") or {}), **extra}
+        try:
+            manifest = parse_manifest(data, source="read-time conditions")
+        except ManifestError as exc:
+            raise CollectionError(str(exc)) from None
+        return Collection(self.root, self.resolved, manifest, self._groundtruth, self._groundtruth_sha256)
+
     def read_time_condition(self, condition: str) -> dict | None:
         """The definition of one of the manifest's ``read_time_conditions`` (its JSON form, the
         unset knobs left out), which the manifest's sha256 does not hold: what a run's cache key

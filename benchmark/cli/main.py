@@ -14,7 +14,7 @@ from benchmark.cli.cameras import app as cameras_app
 from benchmark.cli.help import HELP_SETTINGS
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
-from benchmark.experiments import compare
+from benchmark.experiments import compare, paper_factors
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.suggest import did_you_mean
 from metricscenes.cli_support import SCHEDULER_HELP, fail, progress_bar
@@ -26,6 +26,7 @@ app.add_typer(cameras_app, name="cameras", help="The camera registry: list, show
 cli_detect.register(app)
 cli_leaderboard.register(app)
 compare.register(app)
+paper_factors.register(app)
 console = Console()
 err = Console(stderr=True)
 EXPOSURE_HELP = ("exposure policy for every camera, replacing the camera's own: auto_peak (the paper's), mean_level, "
