@@ -50,3 +50,21 @@ def test_yolov5s_reads_the_dog_photos_pickup_as_a_truck_first():
     (found,) = det.detect([dog], conf_threshold=0.25)
     scores = {d.class_name: round(d.score, 2) for d in found}
     assert scores["dog"] == 0.93 and scores["truck"] == 0.68 and scores["car"] == pytest.approx(0.47, abs=0.015)
+
+
+def test_every_run_states_what_counts_as_the_car(tmp_path, monkeypatch):
+    """COCO's `car` only (docs/detection.md, "What counts as the car"), written in results.json."""
+    import json
+
+    import benchmark.camera.pipeline
+    from benchmark.camera import load_camera
+    from benchmark.coco import COCO80_NAMES, coco_category_id
+    from benchmark.experiments.run import run_camera
+    from benchmark.scoring.ap import CAR_CLASSES
+    from test_sweep_cache import BlankCapture, BlankCollection, BlindDetector
+
+    assert CAR_CLASSES == ("car",) and [coco_category_id(COCO80_NAMES.index(c)) for c in CAR_CLASSES] == [3]
+    monkeypatch.setattr(benchmark.camera.pipeline, "simulate", lambda radiance, camera, seed: BlankCapture())
+    run_camera(BlankCollection(tmp_path), load_camera("cam01"), "day", BlindDetector(), tmp_path / "run",
+               save_images=False)
+    assert json.loads((tmp_path / "run" / "results.json").read_text())["car_classes"] == ["car"]

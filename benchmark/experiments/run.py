@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
-from benchmark.scoring.ap import AP_SCORE_THRESHOLD
+from benchmark.scoring.ap import AP_SCORE_THRESHOLD, CAR_CLASSES
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
     RESULTS_FORMAT, CameraGeometry, CameraRecord, CollectionRecord, DetectorRecord, DistanceAP, RunResults, Subset,
@@ -715,6 +715,7 @@ class _CameraRun:
             detections_file="detections.json",
             detections_sha256=sha256_bytes(detections_bytes),
             timing_s={k: round(v, 3) for k, v in timings.seconds.items()},
+            car_classes=list(CAR_CLASSES),  # what the AP above counts as the car, stated in every run
         )
         # The optional fields are set only where they apply, so that other results keep their bytes
         # (results.json holds the fields set: benchmark.result_files).
