@@ -157,6 +157,8 @@ class RunResults(Record):
     captures_from: str | None = None  # the run folder whose camera images were detected (none simulated)
     composite: str | None = None  # how plate and inset were composited (benchmark.experiments.run.COMPOSITE); None before v0.1.0a5
     condition_weights: dict[str, dict] | None = None  # a targeted condition: per scene, target and weights (metricscenes.targets)
+    condition_spec: dict | None = None  # a read-time condition: its definition (not in the manifest's hash; in the cache key)
+    car_classes: list[str] | None = None  # COCO classes scored as the car (benchmark.scoring.ap.CAR_CLASSES); None: ["car"]
     numerics: dict | None = None  # versions, ISA class and kernels that decided the bytes (metricscenes.numeric_pins)
 
     def ap_curve(self) -> tuple[list[float], list[float]]:

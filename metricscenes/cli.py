@@ -119,6 +119,10 @@ def info(
     as_json: Annotated[bool, typer.Option("--json")] = False,
     photometry: Annotated[bool, typer.Option(
         "--photometry", help="per scene and condition: lux at the camera, image-plane lux at f/2.4")] = False,
+    f_number: Annotated[float, typer.Option(
+        "--f-number", min=0.51, max=63.9, help="with --photometry: the ideal lens of the image-plane lux, and the "
+        "camera whose weights a target_at: camera condition shows (an ideal lens at this f-number over the "
+        "collection's field; a run records its own camera's)")] = 2.4,
 ) -> None:
     """Summarise a collection."""
     from metricscenes.store import Collection
@@ -141,7 +145,8 @@ def info(
     }
     if photometry:  # reads every scene's radiance: damage found on the way is one line
         try:
-            summary["photometry"] = [c.photometry(s.scene_id, cond) for s in scenes for cond in c.held_condition_names]
+            summary["photometry"] = [c.photometry(s.scene_id, cond, f_number) for s in scenes
+                                     for cond in c.held_condition_names]
         except _user_errors() as exc:
             fail(str(exc))
     if as_json:
@@ -149,7 +154,7 @@ def info(
         return
     rows = summary.pop("photometry", [])
     if rows:
-        _photometry_table(rows)
+        _photometry_table(rows, f_number)
     table = Table(title=f"collection {c.name}", show_header=False)
     for k, v in summary.items():
         table.add_row(k, str(v))
@@ -168,17 +173,19 @@ def _generating_now(collection: Path) -> str:
     return f" ({describe(holder)} is generating it now: wait for it)" if holder else ""
 
 
-def _photometry_table(rows: list[dict]) -> None:
+def _photometry_table(rows: list[dict], f_number: float = 2.4) -> None:
     """Mean over scenes, per condition."""
     table = Table(title="photometry (mean over scenes; --json: each scene, and a targeted condition's weights)")
-    for col in ("condition", "lux at camera", "luminance cd/m²", "image-plane lux f/2.4", "min-max", "over target"):
+    for col in ("condition", "lux at camera", "luminance cd/m²", f"image-plane lux f/{f_number:g}", "min-max",
+                "over target"):
         table.add_column(col, justify="right")
     for cond in dict.fromkeys(r["condition"] for r in rows):
         sel = [r for r in rows if r["condition"] == cond]
         mean = {k: sum(r[k] for r in sel) / len(sel)
                 for k in ("illuminance_at_camera_lux", "mean_luminance_cd_m2", "image_plane_illuminance_lux")}
         plane = [r["image_plane_illuminance_lux"] for r in sel]
-        over = (f"{sum(r['targeted']['over_target'] for r in sel)} of {len(sel)}" if "targeted" in sel[0] else "")
+        over = (f"{sum(r['targeted'].get('over_target', False) for r in sel)} of {len(sel)}"
+                if "targeted" in sel[0] else "")
         table.add_row(cond, f"{mean['illuminance_at_camera_lux']:.4g}", f"{mean['mean_luminance_cd_m2']:.4g}",
                       f"{mean['image_plane_illuminance_lux']:.4g}", f"{min(plane):.3g}-{max(plane):.3g}", over)
     console.print(table)

@@ -219,15 +219,36 @@ class IlluminanceSweep(_Strict):
         return _unique(v, "light groups")
 
 
-class TargetedCondition(_Strict):
-    """A condition set by its mean image-plane illuminance through an ideal f/N lens: the
-    lamps at fixed weights, the ambient group scaled per scene to an environment's target,
-    drawn log-uniformly from ``target_image_plane_lux`` (:mod:`metricscenes.targets`)."""
+TARGET_AT = ("reference_lens", "camera")
+"""Where a targeted condition meets its target: the image plane of an ideal lens at
+``f_number`` (the default), or each camera's own optical image, the f-number and any lens
+transmittance taken out as ISETCam's ``oiAdjustIlluminance`` does (the paper's lab)."""
+SCALES = ("ambient", "mix")
+"""What a targeted condition scales to its target: the ambient group, the lamps at their
+fixed weights (the default), or the whole mix, lamps included, its groups' weights fixed
+relative to one another (the paper's lab: isetauto ``iaLightsGroup.m``)."""
+TARGETED_KEYS = ("ambient", "mix", "scales", "target_at", "same_targets_as", "target_image_plane_lux")
 
-    ambient: Literal[PLATE_LIGHT_GROUPS]  # type: ignore[valid-type]
+
+class TargetedCondition(_Strict):
+    """A condition set by its mean image-plane illuminance, drawn per environment
+    log-uniformly from ``target_image_plane_lux`` (:mod:`metricscenes.targets`). Two knobs:
+    ``scales`` (``ambient``: the ambient group scaled under lamps at fixed weights; ``mix``:
+    the groups of ``mix`` scaled together) and ``target_at`` (``reference_lens``: an ideal lens
+    at ``f_number``; ``camera``: each camera's own optical image)."""
+
+    ambient: Literal[PLATE_LIGHT_GROUPS] | None = None  # type: ignore[valid-type]
     lamps: dict[str, Float] = {}
     target_image_plane_lux: tuple[Float, Float]
-    f_number: Float = Field(2.4, gt=0.5, lt=64.0)
+    f_number: Float | None = Field(2.4, gt=0.5, lt=64.0)  # the reference lens's (None: target_at: camera)
+    # Added after manifests were published: None (the defaults, ``scales: ambient`` and
+    # ``target_at: reference_lens``) is left out of the manifest's hash (:func:`manifest_sha256`).
+    scales: Literal[SCALES] | None = None  # type: ignore[valid-type]
+    mix: dict[str, Float] | None = None
+    target_at: Literal[TARGET_AT] | None = None  # type: ignore[valid-type]
+    same_targets_as: str | None = None
+    """Draw each environment's target as this condition does (the same seed, so the two are
+    paired: a comparison between them is not one of target draws)."""
 
     @field_validator("target_image_plane_lux")
     @classmethod
@@ -238,33 +259,97 @@ class TargetedCondition(_Strict):
                              "0 < low <= high < 200000")
         return v
 
-    @field_validator("lamps")
+    @field_validator("lamps", "mix")
     @classmethod
-    def _lamp_weights(cls, v: dict[str, float]) -> dict[str, float]:
-        for group, w in v.items():
+    def _lamp_weights(cls, v: dict[str, float] | None, info) -> dict[str, float] | None:
+        for group, w in (v or {}).items():
             if not (0.0 <= w <= MAX_WEIGHT):
-                raise ValueError(f"lamps.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
+                raise ValueError(f"{info.field_name}.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
         return v
 
+    @model_validator(mode="before")
+    @classmethod
+    def _lens(cls, data):
+        # A target at each camera's image plane has no reference lens: f_number is refused, and
+        # held as None (so the condition's JSON form reads back as it was written).
+        if isinstance(data, dict) and data.get("target_at") == "camera":
+            if data.get("f_number") is not None:
+                raise ValueError("f_number is the reference lens's: target_at: camera meets the target at each "
+                                 "camera's own image plane, through its own f-number and transmittance")
+            return {**data, "f_number": None}
+        if isinstance(data, dict) and "f_number" in data and data["f_number"] is None:
+            return {k: v for k, v in data.items() if k != "f_number"}
+        return data
+
+    @model_validator(mode="after")
+    def _knobs(self) -> "TargetedCondition":
+        # What makes no sense is refused here, before anything is read.
+        if self.scales_mix:
+            if self.ambient is not None or self.lamps:
+                raise ValueError("scales: mix scales every group of mix together: give their fixed weights in mix, "
+                                 "not ambient or lamps")
+            if not self.mix or not any(self.mix.values()):
+                raise ValueError("scales: mix needs mix: {light group: weight, ...} with a weight > 0")
+        else:
+            if self.mix is not None:
+                raise ValueError("mix is the groups scales: mix scales together; scaling the ambient group "
+                                 "(scales: ambient) takes ambient and lamps")
+            if self.ambient is None:
+                raise ValueError("a target needs an ambient group to scale (ambient: <light group>), or "
+                                 "scales: mix and a mix to scale whole")
+        return self
+
+    @property
+    def scales_mix(self) -> bool:
+        return self.scales == "mix"
+
+    @property
+    def at_camera(self) -> bool:
+        return self.target_at == "camera"
+
     def groups(self) -> tuple[str, ...]:
-        return (self.ambient, *self.lamps)
+        return tuple(self.mix) if self.scales_mix else (self.ambient, *self.lamps)
+
+    def parts(self) -> dict[str, dict[str, float]]:
+        """The mixes whose image-plane illuminances set the weights, each with its fixed
+        weights (groups at weight 0 left out): ``ambient`` (the ambient group at 1) and
+        ``lamps``, or ``mix``."""
+        if self.scales_mix:
+            return {"mix": {g: w for g, w in self.mix.items() if w != 0.0}}
+        return {"ambient": {self.ambient: 1.0}, "lamps": {g: w for g, w in self.lamps.items() if w != 0.0}}
+
+    def identity(self) -> dict:
+        """What defines the condition, as the hash reads it (the unset knobs left out)."""
+        return _without_unset_knobs(self.model_dump(mode="json"))
 
 
-def _targeted(name: str, value):
+def _without_unset_knobs(spec: dict) -> dict:
+    """A targeted condition's JSON form without the knobs added later where they are unset."""
+    return {k: v for k, v in spec.items() if not (k in ADDED_TARGETED_KNOBS and v is None)}
+
+
+ADDED_TARGETED_KNOBS = ("ambient", "scales", "mix", "target_at", "same_targets_as")
+
+
+def _targeted(name: str, value, section: str = "conditions"):
     """A condition given as a mapping with a target becomes a :class:`TargetedCondition`;
     its errors name the condition, in one line."""
-    if not (isinstance(value, dict) and {"target_image_plane_lux", "ambient"} & set(value)):
+    if not (isinstance(value, dict) and set(TARGETED_KEYS) & set(value)):
         return value
-    if "ambient" not in value:
-        raise ValueError(f"conditions.{name}: a target needs an ambient group to scale (ambient: <light group>)")
     if "target_image_plane_lux" not in value:
-        raise ValueError(f"conditions.{name}: an ambient group needs target_image_plane_lux: [low, high]")
+        given = next(k for k in TARGETED_KEYS if k in value)
+        what = "an ambient group" if given == "ambient" else given
+        raise ValueError(f"{section}.{name}: {what} needs target_image_plane_lux: [low, high]")
+    if value.get("scales") != "mix" and value.get("ambient") is None:
+        raise ValueError(f"{section}.{name}.ambient: a target needs an ambient group to scale (ambient: <light "
+                         "group>), or scales: mix and a mix to scale whole")
     try:
         return TargetedCondition.model_validate(value)
     except ValidationError as exc:
         first = exc.errors()[0]
         where = ".".join(str(p) for p in first["loc"])
-        raise ValueError(f"conditions.{name}.{where}: {first['msg']}") from None
+        msg = first["msg"].removeprefix("Value error, ")
+        raise ValueError(f"{section}.{name}{'.' + where if where else ''}: {msg}") from None
 
 
 class Manifest(_Strict):
@@ -282,21 +367,28 @@ class Manifest(_Strict):
     conditions: dict[str, dict[str, Float] | TargetedCondition] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
     store: StoreSettings | None = None
+    read_time_conditions: dict[str, dict[str, Float] | TargetedCondition] | None = None
+    """Conditions outside the manifest's identity: mixed at read time from the stored groups
+    like every condition, but left out of its sha256, so that adding one changes no hash that
+    collections, results and submissions are keyed by (their definitions enter the cache keys
+    of the runs that use them instead: ``benchmark.experiments.run.capture_key``). Listed
+    after the conditions and the illuminance sweep's; the same rules, names not repeated."""
 
     @field_validator("light_groups")
     @classmethod
     def _groups_unique(cls, v: tuple[str, ...]) -> tuple[str, ...]:
         return _unique(v, "light groups")
 
-    @field_validator("conditions", mode="before")
+    @field_validator("conditions", "read_time_conditions", mode="before")
     @classmethod
-    def _targeted_conditions(cls, v):
-        return {name: _targeted(name, value) for name, value in v.items()} if isinstance(v, dict) else v
+    def _targeted_conditions(cls, v, info):
+        return ({name: _targeted(name, value, info.field_name) for name, value in v.items()}
+                if isinstance(v, dict) else v)
 
-    @field_validator("conditions")
+    @field_validator("conditions", "read_time_conditions")
     @classmethod
-    def _condition_names(cls, v: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
-        for name in v:
+    def _condition_names(cls, v: dict[str, dict[str, float]] | None) -> dict[str, dict[str, float]] | None:
+        for name in v or {}:
             if "@" in name:
                 raise ValueError(f"condition name {name!r}: '@' is reserved for the illuminance sweep's "
                                  "conditions (<base>@<level>lux)")
@@ -316,25 +408,14 @@ class Manifest(_Strict):
 
     @model_validator(mode="after")
     def _conditions(self) -> "Manifest":
-        for name, weights in self.conditions.items():
-            if isinstance(weights, TargetedCondition):
-                for group in weights.groups():
-                    if group not in self.light_groups:
-                        raise ValueError(f"conditions.{name}: light group {group!r} is not rendered "
-                                         f"(light_groups: {', '.join(self.light_groups)})")
-                if weights.ambient in weights.lamps:
-                    raise ValueError(f"conditions.{name}: {weights.ambient!r} is the ambient group and a lamp")
-                continue
-            for group, w in weights.items():
-                if group not in self.light_groups:
-                    raise ValueError(
-                        f"conditions.{name}.{group}: light group is not rendered "
-                        f"(light_groups: {', '.join(self.light_groups)})"
-                    )
-                if not (0.0 <= w <= MAX_WEIGHT):
-                    raise ValueError(f"conditions.{name}.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
-            if not any(weights.values()):
-                raise ValueError(f"conditions.{name}: lights nothing (give at least one light group a weight > 0)")
+        read_time = self.read_time_conditions or {}
+        both = [n for n in read_time if n in self.conditions]
+        if both:
+            raise ValueError(f"read_time_conditions.{both[0]}: already a condition")
+        every = {**self.conditions, **read_time}
+        for section, conditions in (("conditions", self.conditions), ("read_time_conditions", read_time)):
+            for name, weights in conditions.items():
+                self._check_condition(f"{section}.{name}", name, weights, every)
         sweep = self.illuminance_sweep
         if sweep is not None:
             if sweep.base not in self.conditions:
@@ -349,6 +430,27 @@ class Manifest(_Strict):
                     raise ValueError(f"illuminance_sweep.lamps_on: {group!r} is not a rendered lamp group")
         return self
 
+    def _check_condition(self, where: str, name: str, weights, every: dict) -> None:
+        if isinstance(weights, TargetedCondition):
+            for group in weights.groups():
+                if group not in self.light_groups:
+                    raise ValueError(f"{where}: light group {group!r} is not rendered "
+                                     f"(light_groups: {', '.join(self.light_groups)})")
+            if weights.ambient in weights.lamps:
+                raise ValueError(f"{where}: {weights.ambient!r} is the ambient group and a lamp")
+            paired = weights.same_targets_as
+            if paired is not None and (paired == name or not isinstance(every.get(paired), TargetedCondition)):
+                raise ValueError(f"{where}.same_targets_as: {paired!r} is not another targeted condition")
+            return
+        for group, w in weights.items():
+            if group not in self.light_groups:
+                raise ValueError(f"{where}.{group}: light group is not rendered "
+                                 f"(light_groups: {', '.join(self.light_groups)})")
+            if not (0.0 <= w <= MAX_WEIGHT):
+                raise ValueError(f"{where}.{group}: weight must lie in [0, {MAX_WEIGHT:g}], got {w}")
+        if not any(weights.values()):
+            raise ValueError(f"{where}: lights nothing (give at least one light group a weight > 0)")
+
     @model_validator(mode="after")
     def _frame_grid(self) -> "Manifest":
         divisor, grid = self.render.frame_divisor, self.reference_grid
@@ -359,10 +461,21 @@ class Manifest(_Strict):
 
     @property
     def condition_names(self) -> list[str]:
-        """The conditions, then the illuminance sweep's (``day@0.25lux``, ...)."""
+        """The conditions, then the illuminance sweep's (``day@0.25lux``, ...), then the
+        read-time conditions."""
         sweep = self.illuminance_sweep
         levels = [illuminance_condition(sweep.base, lux) for lux in sweep.levels_lux] if sweep else []
-        return list(self.conditions) + levels
+        return list(self.conditions) + levels + list(self.read_time_conditions or {})
+
+    def condition_spec(self, condition: str):
+        """A named condition's definition (weights or :class:`TargetedCondition`), from
+        ``conditions`` or ``read_time_conditions``; None for a sweep level or no condition."""
+        spec = self.conditions.get(condition)
+        return spec if spec is not None else (self.read_time_conditions or {}).get(condition)
+
+    def is_read_time(self, condition: str) -> bool:
+        """Whether ``condition`` is one of ``read_time_conditions`` (outside the manifest's hash)."""
+        return condition in (self.read_time_conditions or {})
 
     def condition_light_groups(self, condition: str) -> tuple[str, ...]:
         """The light groups ``condition`` mixes, in ``light_groups``' order: those a condition
@@ -373,12 +486,12 @@ class Manifest(_Strict):
             raise ManifestError(f"unknown condition {condition!r} (manifest {self.name} has: "
                                 f"{', '.join(self.condition_names)})")
         sweep = self.illuminance_sweep
-        spec = self.conditions.get(condition) or self.conditions[sweep.base]
+        spec = self.condition_spec(condition) or self.conditions[sweep.base]
         if isinstance(spec, TargetedCondition):
-            mixed = {spec.ambient, *(g for g, w in spec.lamps.items() if w != 0.0)}
+            mixed = {g for part in spec.parts().values() for g in part} | ({spec.ambient} - {None})
         else:
             mixed = {g for g, w in spec.items() if w != 0.0}
-        if condition not in self.conditions:  # a sweep level
+        if self.condition_spec(condition) is None:  # a sweep level
             mixed |= {sweep.ambient_group, *sweep.lamps_on}
         return tuple(g for g in self.light_groups if g in mixed)
 
@@ -468,11 +581,23 @@ HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "
                         ("render", "inset_shadow"))
 
 
+NEVER_HASHED = ("read_time_conditions",)
+"""Top-level fields never part of a manifest's hash (:attr:`Manifest.read_time_conditions`)."""
+
+
+def _is_targeted_json(spec) -> bool:
+    return isinstance(spec, dict) and "target_image_plane_lux" in spec
+
+
 def manifest_sha256(data: dict) -> str:
     """sha256 of a manifest's JSON form (``Manifest.model_dump(mode="json")``, or the
     copy in a collection's resolved manifest): :func:`canonical_sha256` with the
     :data:`HASHED_ONLY_WHEN_SET` fields left out where they are unset (None or absent)."""
-    data = {key: dict(value) if isinstance(value, dict) else value for key, value in data.items()}
+    data = {key: dict(value) if isinstance(value, dict) else value for key, value in data.items()
+            if key not in NEVER_HASHED}
+    if isinstance(data.get("conditions"), dict):  # the targeted conditions' knobs added later, where unset
+        data["conditions"] = {name: _without_unset_knobs(spec) if _is_targeted_json(spec) else spec
+                              for name, spec in data["conditions"].items()}
     for *sections, key in HASHED_ONLY_WHEN_SET:
         holder = data
         for section in sections:

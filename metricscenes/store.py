@@ -69,7 +69,8 @@ from metricscenes.manifest import (
 from metricscenes.radiance import RadianceLayer, SpectralScene, car_sharpness, on_grid_of
 from metricscenes.records import ResolvedManifest, resolved_content_sha256
 from metricscenes.spectral_basis import decode
-from metricscenes.targets import TargetedWeights, ambient_weight, draw_target_lux
+from metricscenes.photometry import image_plane_illuminance_lux
+from metricscenes.targets import TargetedWeights, ambient_weight, draw_target_lux, solve_at_image_plane
 
 _GROUP_LUMINANCE: dict[tuple, float] = {}  # mean luminance of a scene's light group, per version of its files
 
@@ -313,7 +314,8 @@ class Collection:
 
     @property
     def conditions(self) -> dict[str, dict[str, float]]:
-        return self.manifest.conditions
+        """The manifest's conditions and its read-time conditions, by name."""
+        return {**self.manifest.conditions, **(self.manifest.read_time_conditions or {})}
 
     @property
     def reference_grid(self) -> tuple[int, int]:
@@ -406,6 +408,10 @@ class Collection:
         if not isinstance(condition, str):
             return dict(condition)
         if self.is_targeted(condition):
+            if self.targets_camera(condition):
+                raise CollectionError(f"condition {condition} meets its target at each camera's own image plane: its "
+                                      "radiance needs a camera (benchmark run), its weights a camera or a lens "
+                                      "(info --photometry --f-number N)")
             return self.targeted_weights(scene_id, condition).weights
         if condition in self.conditions:
             return dict(self.conditions[condition])
@@ -458,6 +464,58 @@ class Collection:
         """Whether ``condition`` is set by a photometric target (its weights depend on the scene)."""
         return isinstance(self.conditions.get(condition), TargetedCondition)
 
+    def with_read_time_conditions(self, extra: dict) -> "Collection":
+        """This collection with more read-time conditions, given at read time (a program's own
+        variants of a condition: ``benchmark paper-factors``), validated as a manifest's own
+        and refused in one line; the same arrays, hash and caches."""
+        data = self.manifest.model_dump(mode="json")
+        data["read_time_conditions"] = {**(data.get("read_time_conditions") or {}), **extra}
+        try:
+            manifest = parse_manifest(data, source="read-time conditions")
+        except ManifestError as exc:
+            raise CollectionError(str(exc)) from None
+        return Collection(self.root, self.resolved, manifest, self._groundtruth, self._groundtruth_sha256)
+
+    def read_time_condition(self, condition: str) -> dict | None:
+        """The definition of one of the manifest's ``read_time_conditions`` (its JSON form, the
+        unset knobs left out), which the manifest's sha256 does not hold: what a run's cache key
+        and results.json add for it. None for any other condition."""
+        if not isinstance(condition, str) or not self.manifest.is_read_time(condition):
+            return None
+        spec = self.conditions[condition]
+        return spec.identity() if isinstance(spec, TargetedCondition) else dict(spec)
+
+    def targets_camera(self, condition: str) -> bool:
+        """Whether ``condition`` meets its target at each camera's own image plane (``target_at:
+        camera``): its weights depend on the camera too (:meth:`camera_weights`)."""
+        spec = self.conditions.get(condition)
+        return isinstance(spec, TargetedCondition) and spec.at_camera
+
+    def condition_parts(self, condition: str) -> dict[str, dict[str, float]]:
+        """The mixes (light-group weights) whose image-plane illuminances set a targeted
+        condition's weights (``TargetedCondition.parts``), those that light nothing left out:
+        a camera measures each through its lens (``benchmark.camera.image_plane``)."""
+        self.check_condition(condition)
+        return {name: part for name, part in self.conditions[condition].parts().items() if part}
+
+    def camera_weights(self, scene_id: str, condition: str, part_lux: dict[str, float],
+                       at: dict | None = None) -> TargetedWeights:
+        """A ``target_at: camera`` condition's weights in one scene for one camera, from what the
+        camera measured of each of :meth:`condition_parts` at its image plane (``part_lux``,
+        lux); ``at`` (the camera, its lens) is recorded with them."""
+        self.check_condition(condition)
+        spec = self.conditions[condition]
+        try:
+            return solve_at_image_plane(spec, self._target_lux(scene_id, condition), part_lux, at)
+        except ValueError as exc:
+            raise CollectionError(f"{self.root}: scene {scene_id}, condition {condition}: {exc}") from None
+
+    def _target_lux(self, scene_id: str, condition: str) -> float:
+        """The environment's target of a targeted condition (drawn as ``same_targets_as``'s where it names one)."""
+        spec = self.conditions[condition]
+        env = self._image(scene_id)["environment_id"]
+        return draw_target_lux(self.manifest.seed, env, spec.same_targets_as or condition, spec.target_image_plane_lux)
+
     def group_luminances(self, scene_ids: Iterable[str], condition: str) -> dict[tuple, float]:
         """The :meth:`group_luminance` of every light group a targeted ``condition`` weighs, in
         these scenes (computed where this process has not yet), keyed as this process keeps
@@ -465,26 +523,43 @@ class Collection:
         (each is a whole scene read and resampled onto the reference grid: 0.7 core-s on metric-300)."""
         self.check_condition(condition)
         spec = self.conditions[condition]
-        groups = [spec.ambient, *_lamps_on(spec)]
+        if spec.at_camera:  # each camera measures its own image plane: no group luminance is needed
+            return {}
+        groups = [g for part in spec.parts().values() for g in part]
         return dict(self._group_luminance_entry(scene_id, group) for scene_id in scene_ids for group in groups)
 
-    def targeted_weights(self, scene_id: str, condition: str) -> TargetedWeights:
+    def targeted_weights(self, scene_id: str, condition: str, f_number: float | None = None) -> TargetedWeights:
         """A targeted condition's weights in one scene: its environment's target drawn from
-        the condition's range, the ambient weight that meets it (:mod:`metricscenes.targets`)."""
+        the condition's range, the ambient weight (or the whole mix's scale) that meets it
+        (:mod:`metricscenes.targets`). A ``target_at: camera`` condition's depend on the camera:
+        here, those of an ideal camera at f/``f_number`` that sees the collection's field (the
+        registry's cameras: T = 1, no falloff), from the groups' mean luminance over it; a
+        run records its own camera's (:meth:`camera_weights`)."""
         self.check_condition(condition)  # (before its groups are read one by one: the line names the condition)
         spec = self.conditions[condition]
-        env = self._image(scene_id)["environment_id"]
-        target = draw_target_lux(self.manifest.seed, env, condition, spec.target_image_plane_lux)
-        lamps = _lamps_on(spec)
+        target = self._target_lux(scene_id, condition)
+        if spec.at_camera and f_number is None:
+            raise CollectionError(f"condition {condition} meets its target at each camera's own image plane: its "
+                                  "weights need a camera (benchmark run) or a lens (info --photometry --f-number N)")
+        lens = spec.f_number if f_number is None else f_number
         try:
+            if spec.at_camera or spec.scales_mix:
+                part_lux = {name: image_plane_illuminance_lux(
+                    sum(w * self.group_luminance(scene_id, g) for g, w in part.items()), lens)
+                    for name, part in self.condition_parts(condition).items()}
+                at = {"camera": f"ideal lens f/{lens:g} over the collection's field", "f_number": lens,
+                      "part_image_plane_lux": part_lux} if spec.at_camera else None
+                return solve_at_image_plane(spec, target, part_lux, at)
+            lamps = _lamps_on(spec)  # (the first targeted conditions' arithmetic, kept: their weights keep their bits)
             return ambient_weight(target, spec.f_number, self.group_luminance(scene_id, spec.ambient),
                                   {g: self.group_luminance(scene_id, g) for g in lamps}, lamps, spec.ambient)
         except ValueError as exc:
             raise CollectionError(f"{self.root}: scene {scene_id}, condition {condition}: {exc}") from None
 
     def condition_record(self, scene_id: str, condition: str) -> dict | None:
-        """What a targeted condition did in a scene (target, weights, over target), else None."""
-        if isinstance(condition, str) and self.is_targeted(condition):
+        """What a targeted condition did in a scene (target, weights, over target), else None
+        (and None for a ``target_at: camera`` condition, whose weights each camera records)."""
+        if isinstance(condition, str) and self.is_targeted(condition) and not self.targets_camera(condition):
             return self.targeted_weights(scene_id, condition).record()
         return None
 
@@ -496,9 +571,7 @@ class Collection:
         per scene): mixing, compositing, resampling and the mean are linear, so it is the mix's
         own (:meth:`mean_luminance`) to the rounding, and a scene's groups are read once for
         all its conditions (a targeted condition's weights need them anyway)."""
-        from metricscenes.photometry import image_plane_illuminance_lux
-
-        targeted = (self.targeted_weights(scene_id, condition)
+        targeted = (self.targeted_weights(scene_id, condition, f_number if self.targets_camera(condition) else None)
                     if isinstance(condition, str) and self.is_targeted(condition) else None)
         weights = targeted.weights if targeted is not None else self._weights(condition, scene_id)
         luminance = float(sum(w * self.group_luminance(scene_id, g) for g, w in weights.items() if w != 0.0))

@@ -149,3 +149,15 @@ def test_run_command_says_it_is_a_subset(fakes):
     assert result.exit_code == 0, result.output
     assert "subset run (environments 2; distances 25,50 m)" in result.output and "benchmark submit" in result.output
     assert json.loads((out / "results.json").read_text())["subset"] == {"environments": [2], "distances_m": [25.0, 50.0]}
+
+
+def test_a_subset_reaches_a_sweeps_worker_processes(smoke_collection):
+    """A sweep's workers receive the collection pickled: a subset must survive the trip
+    (unpickling looked its attributes up before it had any, and recursed)."""
+    import pickle
+
+    from metricscenes.store import Collection
+
+    subset = subset_collection(Collection.open(smoke_collection), distances="25,50")
+    copy = pickle.loads(pickle.dumps(subset))
+    assert copy.subset == subset.subset and [s.scene_id for s in copy.scenes()] == [s.scene_id for s in subset.scenes()]

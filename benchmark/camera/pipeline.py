@@ -188,7 +188,14 @@ def simulate(scene: SpectralScene, camera: CameraSpec, *, seed: int, noise: bool
         seed: temporal-noise seed (``np.random.default_rng(seed)``): same seed, same raw.
         noise: False switches every noise source off (shot, read, dark, PRNU, DSNU).
     """
-    oi = optical_image(scene, camera)
+    return simulate_on_grid(sensor_radiance(scene, camera), scene.wavelengths_nm, camera, seed=seed, noise=noise)
+
+
+def simulate_on_grid(radiance: np.ndarray, wavelengths_nm: np.ndarray, camera: CameraSpec, *, seed: int,
+                     noise: bool = True) -> Capture:
+    """:func:`simulate` of a radiance already on the camera's pixel grid (:func:`sensor_radiance`):
+    what a condition whose weights depend on the camera mixes there (:mod:`benchmark.camera.image_plane`)."""
+    oi = _optics.optical_image(radiance, wavelengths_nm, camera.optics, camera.pixel_um)
     signal = _sensor.mosaic(_sensor.electron_rate(oi, camera.sensor), camera.sensor.cfa)
     raw = _acquisition.acquire(signal, camera, seed=seed, noise=noise)
     rgb_linear, rgb8 = _isp.render(raw, camera.sensor, camera.isp, calibrate(camera.sensor, camera.isp))

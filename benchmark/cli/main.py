@@ -15,7 +15,7 @@ from benchmark.cli.help import HELP_SETTINGS
 from benchmark.cli.publish import app as publish_app
 from benchmark.detectors.policy import DEFAULT_INPUT_SIZE
 from benchmark.cli import detect as cli_detect, leaderboard as cli_leaderboard
-from benchmark.experiments import compare
+from benchmark.experiments import compare, paper_factors
 from benchmark.leaderboard.protocols import condition_label
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES
 from benchmark.scoring.detectability import FOUND_IOU, FOUND_SCORE
@@ -30,6 +30,7 @@ app.add_typer(publish_app, name="publish", help="The tables of docs/data and doc
 cli_detect.register(app)
 cli_leaderboard.register(app)
 compare.register(app)
+paper_factors.register(app)
 console = Console()
 err = Console(stderr=True)
 EXPOSURE_HELP = ("exposure policy for every camera, replacing the camera's own: auto_peak (the paper's), mean_level, "

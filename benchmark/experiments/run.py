@@ -45,7 +45,7 @@ from benchmark.detectors.policy import parse_input_size
 from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
     CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
 )
-from benchmark.scoring.ap import AP_SCORE_THRESHOLD
+from benchmark.scoring.ap import AP_SCORE_THRESHOLD, CAR_CLASSES
 from metricscenes.files import sha256_file
 from metricscenes.numeric_pins import numeric_provenance
 from benchmark.result_files import (
@@ -131,7 +131,30 @@ def capture_key(camera, condition: str, collection, seed: int) -> dict:
     subset = getattr(collection, "subset", None)
     if subset:
         key["subset"] = subset
+    spec = condition_spec(collection, condition)
+    if spec is not None:  # a read-time condition: its definition is not in the manifest's hash
+        key["condition_spec"] = spec
     return key
+
+
+def condition_spec(collection, condition: str) -> dict | None:
+    """A read-time condition's definition (``Collection.read_time_condition``), None for any
+    other (or for a collection that cannot say: a test double)."""
+    read = getattr(collection, "read_time_condition", None)
+    return None if read is None else read(condition)
+
+
+def read_scene(collection, scene_id: str, condition: str):
+    """A scene under ``condition`` for every camera: its radiance, or for a condition that
+    meets its target at each camera's image plane, its parts and how to weigh them
+    (:class:`benchmark.camera.image_plane.ImagePlaneParts`: each camera its own weights)."""
+    if getattr(collection, "targets_camera", lambda _: False)(condition):
+        from benchmark.camera.image_plane import ImagePlaneParts
+
+        parts = {name: collection.radiance(scene_id, weights, inset_resolution=COMPOSITE)
+                 for name, weights in collection.condition_parts(condition).items()}
+        return ImagePlaneParts(parts, lambda lux, at: collection.camera_weights(scene_id, condition, lux, at))
+    return collection.radiance(scene_id, condition, inset_resolution=COMPOSITE)
 
 
 def results_capture_key(results: RunResults) -> dict:
@@ -143,6 +166,8 @@ def results_capture_key(results: RunResults) -> dict:
         key["camera_geometry"] = results.camera_geometry.model_dump()
     if results.subset is not None:
         key["subset"] = results.subset.model_dump()
+    if results.condition_spec is not None:
+        key["condition_spec"] = results.condition_spec
     return key
 
 
@@ -317,6 +342,8 @@ class CollectionSubset:
                                                          for d in self.subset["distances_m"])
 
     def __getattr__(self, name):
+        if name == "_collection":  # not set yet (a copy being unpickled in a sweep's worker)
+            raise AttributeError(name)
         return getattr(self._collection, name)
 
     def scenes(self):
@@ -499,7 +526,7 @@ def _run_scenes(collection, condition: str, runs: list["_CameraRun"], progress) 
         radiance, read_s = None, 0.0
         if any(run.captures is None and scene.scene_id not in run.done for run in runs):
             t = time.perf_counter()
-            radiance = collection.radiance(scene.scene_id, condition, inset_resolution=COMPOSITE)
+            radiance = read_scene(collection, scene.scene_id, condition)
             read_s = time.perf_counter() - t
         for k in order:
             runs[k].add(scene, radiance, read_s, record)
@@ -558,6 +585,7 @@ class _CameraRun:
         ``record``: what a targeted condition did in it (None for another condition)."""
         from PIL import Image
 
+        from benchmark.camera.image_plane import ImagePlaneParts
         from benchmark.camera.pipeline import simulate
         from benchmark.coco import coco_category_id
 
@@ -569,6 +597,8 @@ class _CameraRun:
             for detections, found in zip(self.detections, staged["detections"]):
                 detections.extend(found)
             self.exposures[scene.scene_id] = staged["exposure_s"]
+            if staged.get("condition_weights") is not None:  # weights of this camera's own (target_at: camera)
+                self.targeted[scene.scene_id] = staged["condition_weights"]
             if staged["exposure_short_s"] is not None:
                 self.short_exposures[scene.scene_id] = staged["exposure_short_s"]
             if self.save_images:  # (a stage begun before images had their sha256 recorded: hashed now)
@@ -579,7 +609,11 @@ class _CameraRun:
         if captures is None:
             timings.seconds["read_radiance"] = timings.seconds.get("read_radiance", 0.0) + read_s
             t = time.perf_counter()
-            capture = simulate(radiance, camera, seed=scene_seed(self.seed, scene.image_id))
+            if isinstance(radiance, ImagePlaneParts):  # its weights are this camera's own
+                capture, self.targeted[scene.scene_id] = radiance.simulate(camera, seed=scene_seed(self.seed,
+                                                                                                   scene.image_id))
+            else:
+                capture = simulate(radiance, camera, seed=scene_seed(self.seed, scene.image_id))
             timings.add("camera", t)
             rgb8, self.exposures[scene.scene_id] = capture.rgb8, capture.exposure_s
             if capture.exposure_short_s is not None:
@@ -588,6 +622,8 @@ class _CameraRun:
             t = time.perf_counter()
             rgb8, captured_sha256 = _captured_image(captures, scene.scene_id, camera)
             self.exposures[scene.scene_id] = captures.results.exposure_s[scene.scene_id]
+            if record is None and (captures.results.condition_weights or {}).get(scene.scene_id) is not None:
+                self.targeted[scene.scene_id] = captures.results.condition_weights[scene.scene_id]  # the camera's own
             if captures.results.exposure_short_s is not None:
                 self.short_exposures[scene.scene_id] = captures.results.exposure_short_s[scene.scene_id]
             timings.add("read_captures", t)
@@ -626,6 +662,8 @@ class _CameraRun:
                  "exposure_short_s": self.short_exposures.get(scene.scene_id)}
         if self.save_images:
             entry["image_sha256"] = self.image_sha256[f"{scene.scene_id}.png"]
+        if isinstance(radiance, ImagePlaneParts):  # weights that are the camera's own are staged with its scene
+            entry["condition_weights"] = self.targeted[scene.scene_id]
         with open(self.checkpoint, "a") as f:  # after the image: a scene listed here is whole
             f.write(json.dumps(entry) + "\n")
 
@@ -679,11 +717,15 @@ class _CameraRun:
             detections_file="detections.json",
             detections_sha256=sha256_bytes(detections_bytes),
             timing_s={k: round(v, 3) for k, v in timings.seconds.items()},
+            car_classes=list(CAR_CLASSES),  # what the AP above counts as the car, stated in every run
         )
         # The optional fields are set only where they apply, so that other results keep their bytes
         # (results.json holds the fields set: benchmark.result_files).
         if self.targeted:
             results.condition_weights = self.targeted
+        spec = condition_spec(collection, self.condition)
+        if spec is not None:  # a read-time condition: what defined it (the manifest's hash does not)
+            results.condition_spec = spec
         if geometry is not None:  # a camera that sees a window of the field
             results.camera_geometry = CameraGeometry(**geometry)
         subset = getattr(collection, "subset", None)

@@ -24,6 +24,9 @@ MAX_DETS = (1, 10, 100)
 ALL_AREAS = [0.0, 1e10]
 # The score a detection needs to be kept for AP: COCO evaluation wants the whole precision-recall
 # curve, so runs keep every detection down to it and a submission's detections must say so.
+CAR_CLASSES = ("car",)
+"""The COCO classes whose detections count as the car in AP: COCO's `car` only, as the paper's
+AP did (docs/detection.md, "What counts as the car"). Every results.json records it."""
 AP_SCORE_THRESHOLD = 0.001
 
 
