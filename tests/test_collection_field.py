@@ -32,6 +32,11 @@ def test_earlier_manifests_keep_their_hash():
     del dumped["reference_grid"]["hfov_deg"], dumped["store"]
     del dumped["render"]["inset_feather"], dumped["render"]["ground_to_horizon"], dumped["render"]["frame_divisor"]
     del dumped["render"]["plate_lamp"], dumped["render"]["rear_retroreflectors"], dumped["render"]["inset_shadow"]
+    del dumped["read_time_conditions"]  # never hashed: conditions made at read time
+    for condition in dumped["conditions"].values():  # a targeted condition's later knobs, unset
+        for knob in ("scales", "mix", "target_at", "same_targets_as"):
+            if knob in condition and condition[knob] is None:
+                del condition[knob]
     assert m.sha256() == canonical_sha256(dumped)
     assert parse_manifest(WIDE).sha256() != parse_manifest({**WIDE, "reference_grid": {
         **WIDE["reference_grid"], "hfov_deg": 61.0}}).sha256()
