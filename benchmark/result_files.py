@@ -134,7 +134,7 @@ class RunResults(Record):
     is the extrapolated number where censored (:meth:`od50_censoring`). The sweep's cache key
     is camera ``spec_sha256``, ``condition``, detector ``sha256`` and ``input_size``,
     collection ``manifest_sha256``, ``seed``, and ``camera_geometry``, ``subset`` and
-    detector ``class_map`` where present (:func:`benchmark.experiments.sweep.results_key`).
+    detector ``class_map`` where present (:func:`benchmark.experiments.keys.results_key`).
     """
 
     format: str | None = None  # RESULTS_FORMAT

@@ -371,7 +371,7 @@ class Manifest(_Strict):
     """Conditions outside the manifest's identity: mixed at read time from the stored groups
     like every condition, but left out of its sha256, so that adding one changes no hash that
     collections, results and submissions are keyed by (their definitions enter the cache keys
-    of the runs that use them instead: ``benchmark.experiments.run.capture_key``). Listed
+    of the runs that use them instead: ``benchmark.experiments.keys.capture_key``). Listed
     after the conditions and the illuminance sweep's; the same rules, names not repeated."""
 
     @field_validator("light_groups")

@@ -288,6 +288,7 @@ def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(seria
     require_model("yolov5n-dynamic.onnx")
     from benchmark.detectors import load_detector
     from benchmark.experiments import run as run_module
+    from benchmark.experiments.keys import resume_key
     from metricscenes.store import Collection
 
     collection = Collection.open(serial_collection)
@@ -348,7 +349,7 @@ def test_a_run_killed_midway_resumes_at_its_next_scene_with_the_same_bytes(seria
     with pytest.raises(KeyboardInterrupt):
         run_module.run_camera(collection, camera, "day", Interrupted([]), tmp_path / "other")
     at_640 = load_detector("yolov5n-dynamic", input_size=640, model_dir=model_dir())
-    stage, resumed = run_module.resumable_stage(tmp_path / "other", run_module.resume_key(
+    stage, resumed = run_module.resumable_stage(tmp_path / "other", resume_key(
         camera, "day", collection, 0, [at_640], True, None))
     assert not resumed and not (stage / run_module.CHECKPOINT).exists()  # another detector's scenes: begun again
 

@@ -60,7 +60,7 @@ def test_custom_classes_dropped_and_merged(tmp_path):
 
 def test_run_records_the_class_map_and_sweep_keys_it(tmp_path):
     from benchmark.camera import load_camera
-    from benchmark.experiments.sweep import results_key, run_key
+    from benchmark.experiments.keys import results_key, run_key
     from benchmark.result_files import RunResults
     from test_sweep_cache import FakeCollection, FakeDetector
 

@@ -252,7 +252,7 @@ def test_weights_are_the_same_in_another_process(smoke, lab_smoke):
 
 def test_capture_key_holds_a_read_time_conditions_definition_and_nothing_new_for_the_others(smoke):
     from benchmark.camera import load_camera
-    from benchmark.experiments.run import capture_key
+    from benchmark.experiments.keys import capture_key
 
     camera = load_camera("cam12")
     night = capture_key(camera, "night", smoke, 0)
@@ -270,7 +270,7 @@ def test_a_sweep_records_each_cameras_weights_the_same_with_any_workers(lab_smok
 
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
-    from benchmark.experiments.run import results_capture_key, capture_key
+    from benchmark.experiments.keys import capture_key, results_capture_key
     from benchmark.experiments.sweep import sweep
     from benchmark.result_files import read_results
     from metricscenes.store import Collection
@@ -307,12 +307,13 @@ def test_a_stopped_run_resumes_with_each_scenes_own_weights(lab_smoke, tmp_path)
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
     from benchmark.experiments import run as run_module
+    from benchmark.experiments.subset import subset_collection
     from metricscenes.store import Collection
 
     spec = tmp_path / "small.yaml"
     spec.write_text("name: small\noptics: {f_number: 4.0}\nsensor: {pixel_um: 11.2}\n")
     camera = load_camera(spec)
-    collection = run_module.subset_collection(Collection.open(lab_smoke), distances="25,50")
+    collection = subset_collection(Collection.open(lab_smoke), distances="25,50")
     detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
     whole = run_module.run_camera(collection, camera, "night_lab", detector, tmp_path / "whole")
 

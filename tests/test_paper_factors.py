@@ -67,7 +67,8 @@ def test_on_smoke_the_first_row_is_the_runs_night_and_a_second_run_resumes(smoke
     require_model("yolov5s-dynamic.onnx")
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
-    from benchmark.experiments.run import run_camera, subset_collection
+    from benchmark.experiments.run import run_camera
+    from benchmark.experiments.subset import subset_collection
     from metricscenes.store import Collection
 
     specs = []

@@ -10,7 +10,8 @@ from typer.testing import CliRunner
 
 from benchmark.camera import load_camera
 from benchmark.cli.main import app
-from benchmark.experiments.run import CollectionSubset, parse_subset, run_camera, subset_collection
+from benchmark.experiments.run import run_camera
+from benchmark.experiments.subset import CollectionSubset, parse_subset, subset_collection
 from test_sweep_cache import N_ENV, FakeCollection, FakeDetector, fake_run_camera, patch_runs
 
 
@@ -101,7 +102,7 @@ def test_subset_sweep_is_marked_and_never_reused_as_full(fakes):
 
 
 def test_subset_cache_key(tmp_path):
-    from benchmark.experiments.sweep import results_key, run_key
+    from benchmark.experiments.keys import results_key, run_key
     from benchmark.result_files import RunResults
 
     col = FakeCollection(tmp_path)

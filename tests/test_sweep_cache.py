@@ -417,6 +417,7 @@ def test_a_sweep_killed_after_its_runs_moved_into_place_leaves_nothing_once_reru
     import subprocess
 
     from benchmark.experiments import run as run_module
+    from benchmark.experiments.keys import resume_key
 
     out = tmp_path / "sw"
     make_fake_sweep(out, monkeypatch)
@@ -426,7 +427,7 @@ def test_a_sweep_killed_after_its_runs_moved_into_place_leaves_nothing_once_reru
     for name, seed in (("cam01-day", 0), ("cam12-day", 1)):
         folder = out / "runs" / name
         camera = load_camera(name.split("-")[0])
-        run_module.resumable_stage(folder, run_module.resume_key(camera, "day", collection, seed, [detector], False, None))
+        run_module.resumable_stage(folder, resume_key(camera, "day", collection, seed, [detector], False, None))
         (folder / ".partial-a1b2c3").mkdir()
         (folder / "benchmark.lock").write_text(json.dumps({"pid": dead.pid, "host": socket.gethostname()}))
     rerun = CountingRun()
@@ -441,7 +442,7 @@ def test_a_failed_or_one_environment_sweep_leaves_no_folder(tmp_path, monkeypatc
     folder; one environment (no bootstrap SD) is refused before any run."""
     import errno
 
-    from benchmark.experiments.run import subset_collection
+    from benchmark.experiments.subset import subset_collection
 
     def disk_full(*args, **kwargs):
         raise OSError(errno.ENOSPC, "No space left on device")

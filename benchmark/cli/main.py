@@ -99,7 +99,8 @@ def run(
     from benchmark.camera import load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.camera.exposure import check_exposure_override, format_exposure, parse_exposure, with_exposure
-    from benchmark.experiments.run import check_out_dir, run_camera, subset_collection
+    from benchmark.experiments.run import check_out_dir, run_camera
+    from benchmark.experiments.subset import subset_collection
     from benchmark.experiments.run_folder import check_run_folder
     from metricscenes.outputs import RUN, check_output
     from metricscenes.store import Collection, CollectionError
@@ -194,7 +195,8 @@ def sweep(
     from benchmark.camera import camera_names, load_camera
     from benchmark.detectors import DetectorError, load_detector
     from benchmark.camera.exposure import format_exposure, parse_exposure
-    from benchmark.experiments.run import check_out_dir, check_pass_policies, subset_collection
+    from benchmark.experiments.run import check_out_dir, check_pass_policies
+    from benchmark.experiments.subset import subset_collection
     from metricscenes.backends import BackendError, runs_in_process, threads_per_unit
     from metricscenes.outputs import SWEEP, check_output
     from metricscenes.store import Collection, CollectionError

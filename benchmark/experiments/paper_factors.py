@@ -166,11 +166,6 @@ def plan(collection, cameras, base_name: str = "night", which: str = "both", mod
     return {"base": base_name, "base_spec": base, "rows": rows, "conditions": conditions}
 
 
-def _unit_key(collection_sha: str, camera, env: int, scene_ids, rows_config, seed: int) -> dict:
-    return {"format": TABLE_FORMAT, "manifest_sha256": collection_sha, "camera": camera.sha256(),
-            "environment": env, "scenes": list(scene_ids), "rows": rows_config, "seed": seed}
-
-
 def _rows_config(rows, base_name: str, base: dict, camera, detector_sha: dict) -> list[dict]:
     out = []
     for row in rows:
@@ -247,7 +242,9 @@ def run_factors(collection, cameras, out_dir, *, base_name: str = "night", which
     ``environments``, ``distances``: a subset, as ``benchmark run --environments/--distances``."""
     from benchmark.camera.pipeline import lens_mapping
     from benchmark.detectors.registry import resolve_model, verify_sha256
-    from benchmark.experiments.run import collection_field, parse_subset
+    from benchmark.experiments.keys import factor_unit_key
+    from benchmark.experiments.run import collection_field
+    from benchmark.experiments.subset import parse_subset
     from metricscenes.backends import map_units, threads_per_unit
     from metricscenes.store import scale_groundtruth
 
@@ -274,7 +271,7 @@ def run_factors(collection, cameras, out_dir, *, base_name: str = "night", which
         configs = _rows_config(p["rows"], base_name, p["base_spec"], camera, detector_sha)
         for env in envs:
             ids = [s.scene_id for s in scenes if s.environment_id == env]
-            key = _unit_key(collection.manifest_sha256, camera, env, ids, configs, seed)
+            key = factor_unit_key(collection.manifest_sha256, camera, env, ids, configs, seed)
             path = units_dir / f"{camera.name}-env{env:03d}.json"
             paths[(camera.name, env)] = path
             try:

@@ -75,7 +75,7 @@ def remove_stale_stages(out_dir: Path) -> list[Path]:
 def remove_finished_leftovers(out_dir: Path, key) -> None:
     """What a run killed after its files moved into place (before it removed its stage and
     lock) left in ``out_dir``, whose run is finished: the staging folders, the resumable one
-    where it is of ``key()`` (this very run's :func:`benchmark.experiments.run.resume_key`: nothing in it is needed; another
+    where it is of ``key()`` (this very run's :func:`benchmark.experiments.keys.resume_key`: nothing in it is needed; another
     run's is kept for that run), and the stale lock. Untouched while another process holds the lock."""
     from metricscenes.lock import OUTPUT_LOCK_FILE, LockError, output_lock
 

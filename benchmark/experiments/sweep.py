@@ -5,7 +5,7 @@ Each (camera, condition) pair is one run in ``out_dir/runs/<camera>-<condition>/
 of several policies share one folder without overwriting). Runs are cached: a run folder whose
 ``results.json`` carries the same key — camera spec sha256, condition, detector sha256
 and input size, collection manifest sha256, seed — is reused, not recomputed.
-A collection subset (:class:`benchmark.experiments.run.CollectionSubset`, ``--environments`` /
+A collection subset (:class:`benchmark.experiments.subset.CollectionSubset`, ``--environments`` /
 ``--distances``) adds ``subset`` to the key and ``+subset-<hash>`` to the folder name.
 A run writes ``results.json`` last, so a sweep that was killed resumes with
 only its missing (or stale) runs. A condition's missing runs are done together, scene by
@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
+from benchmark.experiments.keys import results_key, run_key
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
 from benchmark.result_files import (
@@ -81,35 +82,6 @@ def run_name(camera_name: str, condition: str, exposure_tag: str | None = None) 
     if exposure_tag:
         check_path_name(exposure_tag, "exposure tag")
     return f"{camera_name}-{condition}" + (f"+{exposure_tag}" if exposure_tag else "")
-
-
-def run_key(camera, condition: str, detector, collection, seed: int) -> dict:
-    """What makes two runs interchangeable (the cache key): what made the camera's images
-    (:func:`benchmark.experiments.run.capture_key`; a camera that sees a window of the
-    collection's field adds its geometry, so runs made before cameras had their own field of
-    view are redone, while the registry cameras' keys are unchanged) and the detector."""
-    from benchmark.experiments.run import capture_key
-
-    key = {**capture_key(camera, condition, collection, seed),
-           "model_sha256": detector.sha256, "input_size": str(detector.input_size)}
-    if getattr(detector, "class_map", None) is not None:  # the same model file read through another class map
-        from benchmark.detectors.classmap import class_map_names
-
-        key["class_map"] = class_map_names(detector.class_map)
-    return key
-
-
-def results_key(results: RunResults) -> dict | None:
-    """The cache key recorded in a ``results.json`` (None for one that names no detector: never reused)."""
-    from benchmark.experiments.run import results_capture_key
-
-    if results.detector is None:
-        return None
-    key = {**results_capture_key(results),
-           "model_sha256": results.detector.sha256, "input_size": str(results.detector.input_size)}
-    if results.detector.class_map is not None:
-        key["class_map"] = results.detector.class_map
-    return key
 
 
 def captures_for(run_dir: Path, camera, condition: str, collection, seed: int) -> Path | None:
@@ -234,7 +206,7 @@ def camera_groups(cameras: list, n_groups: int) -> list[list]:
     """The cameras split into at most ``n_groups`` groups of about equal pixel counts (largest
     first, each to the lightest group), cameras of one pixel grid always together so that a
     scene's resample serves them all; deterministic, cameras in their given order within a grid."""
-    from benchmark.experiments.run import grid_key
+    from benchmark.experiments.keys import grid_key
 
     grids: dict[tuple, list] = {}
     for camera in cameras:
@@ -292,7 +264,9 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     Returns:
         The tidy table of ``sweep.csv`` (columns :data:`TABLE_COLUMNS`).
     """
+    from benchmark.experiments import keys
     from benchmark.experiments import run as run_module
+    from benchmark.experiments.subset import subset_tag
     from benchmark.experiments.run_folder import remove_finished_leftovers
     from benchmark.camera.pipeline import camera_window
     from benchmark.camera import load_camera
@@ -317,7 +291,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     tags = {c.name: exposure_tag(exposure) if c.exposure != o.exposure else None for c, o in zip(cameras, own)}
     subset = getattr(collection, "subset", None)
     # A subset's runs live in their own folders (cam01-day+subset-1a2b3c4d): a quick try never overwrites a full run.
-    suffix = f"+{run_module.subset_tag(subset)}" if subset else ""
+    suffix = f"+{subset_tag(subset)}" if subset else ""
     conditions = list(conditions)
     if not cameras or not conditions:
         raise ValueError("sweep needs at least one camera and one condition")
@@ -380,7 +354,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
                                     camera, condition, collection, seed)
 
             def resume_key(camera, condition: str) -> dict:  # what the stage of this camera's runs is keyed by
-                return run_module.resume_key(camera, condition, collection, seed, list(detectors.values()),
+                return keys.resume_key(camera, condition, collection, seed, list(detectors.values()),
                                              save_images, captures(camera, condition))
 
             todo = []

@@ -39,7 +39,8 @@ def main() -> None:
 
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
-    from benchmark.experiments.run import run_camera, run_cameras, subset_collection
+    from benchmark.experiments.run import run_camera, run_cameras
+    from benchmark.experiments.subset import subset_collection
     from metricscenes.store import Collection
 
     collection = subset_collection(Collection.open(args.collection), args.environments, None)
