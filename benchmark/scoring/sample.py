@@ -14,7 +14,7 @@ in docs/scoring.md ("Minimum sample") that sets it.
 
 from __future__ import annotations
 
-MIN_ENVIRONMENTS = 5  # measured: see docs/scoring.md
+MIN_ENVIRONMENTS = 5  # a floor against the degenerate bootstrap (docs/scoring.md, "Minimum sample")
 """Fewest environments per distance behind a verdict (compare, report) or an unmarked figure
 (sweep, report, leaderboard tables); set from camera-vs-reseeded-camera comparisons
 (docs/scoring.md, "Minimum sample")."""
