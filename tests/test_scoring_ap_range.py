@@ -32,7 +32,7 @@ def test_near_end_held_order_nan_and_errors():
     assert ap_range([100.0], [0.5]) == pytest.approx(50.0)
     with pytest.raises(ValueError, match="distinct"):
         ap_range([25.0, 25.0], [0.5, 0.6])
-    with pytest.raises(ValueError, match="none finite"):
+    with pytest.raises(ValueError, match="got 0 finite points"):
         ap_range([25.0], [math.nan])
     with pytest.raises(ValueError, match="same length"):
         ap_range([25.0, 50.0], [0.5])

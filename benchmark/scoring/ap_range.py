@@ -16,22 +16,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from benchmark.scoring.od50 import finite_points
+
 
 def ap_range(distances_m, ap) -> float:
     """Area under AP vs distance in metres (see the module docstring); one finite point or more."""
-    d = np.asarray(distances_m, dtype=np.float64).ravel()
-    a = np.asarray(ap, dtype=np.float64).ravel()
-    if d.shape != a.shape:
-        raise ValueError(f"distances_m and ap must have the same length, got {d.size} and {a.size}")
-    ok = np.isfinite(a) & np.isfinite(d)
-    d, a = d[ok], a[ok]
-    if d.size == 0:
-        raise ValueError("ap_range needs AP at one distance or more, got none finite")
-    if np.any(d < 0):
-        raise ValueError(f"distances_m must be >= 0, got {d.min():g}")
-    order = np.argsort(d, kind="stable")
-    d, a = d[order], a[order]
-    if np.any(np.diff(d) == 0):
-        raise ValueError(f"distances_m must be distinct, got {d.tolist()}")
+    d, a = finite_points(distances_m, ap, at_least=1, what="ap_range")
+    if d[0] < 0:
+        raise ValueError(f"distances_m must be >= 0, got {d[0]:g}")
     # 0 to d_min at the nearest AP (a car nearer than measured is found at least as well), then trapezoids
     return float(a[0] * d[0] + np.sum(0.5 * (a[1:] + a[:-1]) * np.diff(d)))

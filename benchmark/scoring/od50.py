@@ -40,16 +40,16 @@ def _line_at(d0: float, a0: float, d1: float, a1: float, level: float) -> float:
     return d0 + (level - a0) * (d1 - d0) / (a1 - a0)
 
 
-def _finite_points(distances_m, ap) -> tuple[np.ndarray, np.ndarray]:
-    """The (distance, AP) points with finite values, sorted by distance: two or more, distinct."""
+def finite_points(distances_m, ap, *, at_least: int = 2, what: str = "od50") -> tuple[np.ndarray, np.ndarray]:
+    """The (distance, AP) points with finite values, sorted by distance: ``at_least`` of them, distinct."""
     d = np.asarray(distances_m, dtype=np.float64).ravel()
     a = np.asarray(ap, dtype=np.float64).ravel()
     if d.shape != a.shape:
         raise ValueError(f"distances_m and ap must have the same length, got {d.size} and {a.size}")
     ok = np.isfinite(a) & np.isfinite(d)
     d, a = d[ok], a[ok]
-    if d.size < 2:
-        raise ValueError(f"od50 needs AP at two or more distances, got {d.size} finite points")
+    if d.size < at_least:
+        raise ValueError(f"{what} needs AP at {at_least} or more distances, got {d.size} finite points")
     order = np.argsort(d, kind="stable")
     d, a = d[order], a[order]
     if np.any(np.diff(d) == 0):
@@ -59,7 +59,7 @@ def _finite_points(distances_m, ap) -> tuple[np.ndarray, np.ndarray]:
 
 def od50(distances_m, ap, *, level: float = AP_LEVEL) -> float:
     """Distance in metres where AP crosses ``level`` (0.5); see the module docstring for the rules."""
-    d, a = _finite_points(distances_m, ap)
+    d, a = finite_points(distances_m, ap)
     down = np.nonzero((a[:-1] >= level) & (a[1:] < level))[0]
     if down.size:
         i = int(down[0])
@@ -88,7 +88,7 @@ def od50_censoring(distances_m, ap, *, level: float = AP_LEVEL) -> tuple[str, fl
     ``"<"``, nearest distance: AP is below ``level`` at every measured distance (rule 3): an
     upper bound, "< 25 m". ``""`` and None: a crossing was measured (rule 1).
     """
-    d, a = _finite_points(distances_m, ap)
+    d, a = finite_points(distances_m, ap)
     if np.any((a[:-1] >= level) & (a[1:] < level)):
         return NOT_CENSORED, None
     if a[-1] >= level:
