@@ -49,7 +49,8 @@ def finite_points(distances_m, ap, *, at_least: int = 2, what: str = "od50") -> 
     ok = np.isfinite(a) & np.isfinite(d)
     d, a = d[ok], a[ok]
     if d.size < at_least:
-        raise ValueError(f"{what} needs AP at {at_least} or more distances, got {d.size} finite points")
+        count = {1: "one", 2: "two"}.get(at_least, str(at_least))
+        raise ValueError(f"{what} needs AP at {count} or more distances, got {d.size} finite points")
     order = np.argsort(d, kind="stable")
     d, a = d[order], a[order]
     if np.any(np.diff(d) == 0):
