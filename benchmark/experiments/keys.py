@@ -31,11 +31,15 @@ if TYPE_CHECKING:
     from benchmark.result_files import RunResults
 
 
+
+PAPER_FACTORS_FORMAT = "metricscenes-paper-factors/1"
+"""The format of `benchmark paper-factors`' table and of its units' keys (a new one invalidates them)."""
+
 def capture_key(camera, condition: str, collection, seed: int) -> dict:
     """What makes two runs' camera images interchangeable: camera spec sha256, condition,
     collection manifest sha256, seed, and the camera's geometry and the collection subset
     where present (the detector is not part of it)."""
-    from benchmark.experiments.run import COMPOSITE, camera_geometry, condition_spec
+    from benchmark.experiments.collection_view import COMPOSITE, camera_geometry, condition_spec
 
     key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
            "manifest_sha256": collection.manifest_sha256, "seed": int(seed), "composite": COMPOSITE}
@@ -110,7 +114,6 @@ def results_key(results: RunResults) -> dict | None:
 def factor_unit_key(collection_sha: str, camera, env: int, scene_ids, rows_config, seed: int) -> dict:
     """What one unit of ``benchmark paper-factors`` (a camera × an environment through every row) was
     made with; a unit file under ``units/`` of another key is redone."""
-    from benchmark.experiments.paper_factors import TABLE_FORMAT
 
-    return {"format": TABLE_FORMAT, "manifest_sha256": collection_sha, "camera": camera.sha256(),
+    return {"format": PAPER_FACTORS_FORMAT, "manifest_sha256": collection_sha, "camera": camera.sha256(),
             "environment": env, "scenes": list(scene_ids), "rows": rows_config, "seed": seed}

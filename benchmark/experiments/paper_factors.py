@@ -41,8 +41,9 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
+from benchmark.experiments.keys import PAPER_FACTORS_FORMAT
+
 UNITS_DIR = "units"
-TABLE_FORMAT = "metricscenes-paper-factors/1"
 
 
 @dataclass(frozen=True)
@@ -349,7 +350,7 @@ def score_table(p: dict, per_camera: dict, *, mtf_source: str = "measured") -> d
                  f"ap_{near:g}m_slow": round(float(np.mean([ap[n][near] for n in slow])), 3) if slow else None,
                  "ap": {n: {f"{d:g}": round(ap[n][d], 3) for d in distances} for n in names}}
         rows.append(entry)
-    return {"format": TABLE_FORMAT, "base": p["base"], "base_spec": p["base_spec"],
+    return {"format": PAPER_FACTORS_FORMAT, "base": p["base"], "base_spec": p["base_spec"],
             "factors": [f.__dict__ for f in FACTORS], "conditions": p["conditions"],
             "cameras": {c.name: {"pixel_um": c.pixel_um, "f_number": c.f_number, "p2_over_n2": round(light[c.name], 5),
                                  "mtf50_cy_per_mm": None if mtf50[c.name] is None else round(mtf50[c.name], 2)}

@@ -43,6 +43,9 @@ import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
 from benchmark.experiments.keys import capture_key, grid_key, results_capture_key, resume_key
+from benchmark.experiments.collection_view import (  # noqa: F401 (named here too: run's API)
+    COMPOSITE, _geometry_record, camera_geometry, collection_field, condition_spec,
+)
 from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
     CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
 )
@@ -54,10 +57,6 @@ from benchmark.result_files import (
     RunResults, Subset, write_image_hashes, write_results,
 )
 
-# How the collection's layers are composited for a camera (metricscenes.store.Collection.radiance):
-# "car" since v0.1.0a5 (CHANGELOG.md), the inset at its own resolution only around the car. Runs made
-# before it recorded none, so a sweep does not take them for this composite's.
-COMPOSITE = "car"
 # What a name that becomes a file or folder name may not hold (one rule for all of them):
 # a way out of its folder, a separator on any OS, or characters that break a line or a C string.
 FORBIDDEN_IN_NAMES = ("..", "/", "\\", "\0", "\n", "\r")
@@ -88,43 +87,6 @@ def check_out_dir(out_dir, what: str = "--out") -> Path:
         raise ValueError(f"{what} {out_dir} {where} the collection {inside}: collections are read-only to "
                          "benchmark, choose a folder outside it")
     return out_dir
-
-
-def collection_field(collection):
-    """The field (tangent extent) a collection's plates and ground-truth grid cover
-    (``Collection.field``), or the reference field for an object that cannot say (a
-    test double)."""
-    from metricscenes.geometry import REFERENCE_EXTENT
-
-    return getattr(collection, "field", REFERENCE_EXTENT)
-
-
-def camera_geometry(collection, camera) -> dict | None:
-    """Where the camera sees less than the collection's field: its field and window, as
-    recorded in results.json (``camera_geometry``) and in the sweep cache key; None for a
-    camera that sees the whole field (the 13 registry cameras), whose results keep their
-    bytes. :class:`benchmark.camera.pipeline.FieldOfViewError` for a camera that sees more."""
-    from benchmark.camera.pipeline import camera_window
-
-    field = collection_field(collection)
-    return _geometry_record(camera, field, camera_window(camera, field))
-
-
-def _geometry_record(camera, field, window) -> dict | None:
-    """:func:`camera_geometry` of a camera whose window of ``field`` is known."""
-    from metricscenes.geometry import fov_deg
-
-    if window == field:
-        return None
-    return {"hfov_deg": round(camera.hfov_deg, 6), "vfov_deg": round(camera.vfov_deg, 6),
-            "window_tan": list(window.as_tuple()), "collection_fov_deg": [round(v, 6) for v in fov_deg(field)]}
-
-
-def condition_spec(collection, condition: str) -> dict | None:
-    """A read-time condition's definition (``Collection.read_time_condition``), None for any
-    other (or for a collection that cannot say: a test double)."""
-    read = getattr(collection, "read_time_condition", None)
-    return None if read is None else read(condition)
 
 
 def read_scene(collection, scene_id: str, condition: str):

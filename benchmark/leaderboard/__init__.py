@@ -10,7 +10,8 @@ See docs/leaderboard.md for the format and the rules.
 from benchmark.leaderboard.detections import DETECTIONS_FORMAT, pack, pack_path, read_pack
 from benchmark.leaderboard.files import tree_sha256
 from benchmark.leaderboard.protocols import Protocol, condition_label, load_protocols
-from benchmark.leaderboard.render import load_submissions, rank_key, render_html, render_leaderboard, render_markdown
+from benchmark.leaderboard.folder import load_submissions
+from benchmark.leaderboard.render import rank_key, render_html, render_leaderboard, render_markdown
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError, check_schema, loads_strict, schema_text, submission_schema
 from benchmark.leaderboard.submission import (
     Run,

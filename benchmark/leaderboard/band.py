@@ -48,9 +48,9 @@ def reference_band(submissions: list[dict], protocol: Protocol, *, manifest_sha2
 
 def references_of(protocol_name: str, leaderboard_dir: str | Path, *, manifest_sha256: str | None = None) -> tuple[Protocol, list[ConditionBand]]:
     """(protocol, band) of a leaderboard folder's references of ``protocol_name`` (every
-    submission validated first: :func:`benchmark.leaderboard.render.load_submissions`)."""
+    submission validated first: :func:`benchmark.leaderboard.folder.load_submissions`)."""
     from benchmark.leaderboard.protocols import load_protocols
-    from benchmark.leaderboard.render import load_submissions
+    from benchmark.leaderboard.folder import load_submissions
 
     if not Path(leaderboard_dir).is_dir():
         raise ValueError(f"--references: no leaderboard folder {leaderboard_dir} (name one with --leaderboard)")

@@ -26,6 +26,9 @@ from pathlib import Path
 
 from benchmark.leaderboard.schema import SubmissionError, loads_strict
 
+AP_TOLERANCE = 1e-6  # a recomputed AP agrees with the claimed one to float rounding
+OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
+
 DETECTIONS_FORMAT = "metricscenes-detections/1"
 CAR_CATEGORY_ID = 3
 MAX_PACK_BYTES = 16 * 1024 * 1024  # compressed; a metric-300 condition is about 0.5 MB
@@ -127,10 +130,9 @@ def read_pack(path: str | Path, *, expected_sha256: str, source: str | None = No
 def recompute(data: dict, condition: str, body: dict, *, source: str) -> None:
     """Refuse, in one line naming the field, the claimed and the recomputed value, any AP, AP50,
     image count, OD50 or environment count of ``data``'s ``condition`` that its pack ``body``
-    does not give (AP within :data:`benchmark.leaderboard.validate.AP_TOLERANCE`: float rounding)."""
+    does not give (AP within :data:`AP_TOLERANCE`: float rounding)."""
     import math
 
-    from benchmark.leaderboard.validate import AP_TOLERANCE, OD50_TOLERANCE_M
     from benchmark.scoring import ap_by_distance, od50
 
     cond = data["conditions"][condition]

@@ -35,6 +35,7 @@ import warnings
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
+from benchmark.leaderboard.detections import AP_TOLERANCE, OD50_TOLERANCE_M
 from benchmark.leaderboard.protocols import Protocol, load_protocols
 from benchmark.leaderboard.schema import SubmissionError, check_schema, check_values, loads_strict
 from metricscenes.files import sha256_file
@@ -45,8 +46,6 @@ MTF50_TOLERANCE = 0.1  # cy/mm: submissions round MTF50 to 0.1 cy/mm (one step o
 NAMED_FIELDS = (("submitter",), ("camera", "name"), ("detector", "name"), ("detector", "family"),
                 ("detector", "licence"), ("collection", "name"), ("package_version",))
 NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
-AP_TOLERANCE = 1e-6
-OD50_TOLERANCE_M = 1e-3  # results round OD50 to the millimetre
 CLOCK_TOLERANCE = timedelta(days=1)  # created_at may be this far ahead of the checker's clock
 EARLIEST_CREATED_AT = datetime(2023, 1, 1, tzinfo=timezone.utc)  # the protocol's paper (Liu et al., EI 2023)
 MAX_OD50_M = 1e9  # beyond any extrapolated OD50 of a real AP curve (the committed ones reach 3e5 m)
