@@ -37,7 +37,7 @@ def grid_field(manifest: dict | None) -> TanExtent:
 def box_problem(img: dict, boxes: list, mask: np.ndarray, extent: TanExtent, field: TanExtent) -> str | None:
     """Is ``boxes`` (the scene's ground truth) exactly the one box its mask gives on the
     reference grid covering ``field``? None: yes."""
-    from metricscenes.store import GROUNDTRUTH_FILE
+    from metricscenes.checked_read import GROUNDTRUTH_FILE
 
     scene_id = img["scene_id"]
     expected = mask_box_xywh(mask, extent, img["width"], img["height"], field) if mask.dtype == bool else None
@@ -56,7 +56,7 @@ def groundtruth_problems(root: Path, group, groundtruth: dict, groundtruth_sha25
     written before it, or an unusable resolved manifest) or differs, every scene is
     checked against the plan and its box recomputed from its mask, so that each problem
     names its scene."""
-    from metricscenes.store import GROUNDTRUTH_FILE, CollectionError, _extent, read_checked
+    from metricscenes.checked_read import GROUNDTRUTH_FILE, CollectionError, _extent, read_checked
 
     recorded = resolved.groundtruth_sha256 if resolved is not None else None
     if recorded is not None and recorded == groundtruth_sha256:

@@ -50,82 +50,34 @@ from the masks instead; those written before attributes had one are read uncheck
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import yaml
 
+from metricscenes.checked_read import (  # noqa: F401 (the store's API)
+    _CHECKED, DIMENSIONS, GROUNDTRUTH_FILE, PROGRESS_DIR, RADIANCE_STORE, REPAIR_HINT, RESOLVED_MANIFEST_FILE,
+    CollectionError, _extent, _fingerprint, _radiance_shape, array_sha256, attributes_sha256, check_attributes,
+    read_checked,
+)
+from metricscenes.collection_files import (  # noqa: F401 (the store's API)
+    ATTRIBUTES_UPGRADE_NOTE, _load_groundtruth, _load_resolved, _parse_manifest, _progress_arrays,
+    collection_containing, file_in_the_way, unfinished_generation, upgrade_notes, verify_collection,
+)
 from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import scale_groundtruth  # noqa: F401 -- store API: ground truth on a camera's grid
 from metricscenes.groundtruth_checks import box_problem, groundtruth_problems, mask_box_xywh  # noqa: F401 -- verify's
 from metricscenes.manifest import (
-    Manifest, ManifestError, TargetedCondition, canonical_sha256, load_manifest, manifest_sha256,
-    parse_illuminance_condition, parse_manifest,
+    Manifest, ManifestError, TargetedCondition, load_manifest, parse_illuminance_condition, parse_manifest,
 )
 from metricscenes.radiance import RadianceLayer, SpectralScene, car_sharpness, on_grid_of
-from metricscenes.records import ResolvedManifest, resolved_content_sha256
-from metricscenes.spectral_basis import decode
+from metricscenes.records import ResolvedManifest
 from metricscenes.photometry import image_plane_illuminance_lux
 from metricscenes.targets import TargetedWeights, ambient_weight, draw_target_lux, solve_at_image_plane
 
 _GROUP_LUMINANCE: dict[tuple, float] = {}  # mean luminance of a scene's light group, per version of its files
-
-RADIANCE_STORE = "radiance.zarr"
-GROUNDTRUTH_FILE = "groundtruth.json"
-RESOLVED_MANIFEST_FILE = "manifest.resolved.yaml"
-PROGRESS_DIR = "progress"
-DIMENSIONS = ("y", "x", "wavelength")
-REPAIR_HINT = "rerun `metricscenes generate` with its manifest to repair it"
-ATTRIBUTES_UPGRADE_NOTE = ("its arrays' attributes have no recorded sha256 (the collection was written before they "
-                           "had one): rerun `metricscenes generate` with its manifest to record them (it renders "
-                           "nothing when they are the ones written)")
-
-
-class CollectionError(ValueError):
-    """A collection folder is missing, incomplete or corrupted (one-line message)."""
-
-
-# Arrays that matched their sha256 in this process, by file version (see _fingerprint):
-# reading a plate shared by six scenes, or a scene under several conditions, hashes it once.
-_CHECKED: set[tuple] = set()
-
-
-def array_sha256(array: np.ndarray) -> str:
-    """sha256 over dtype, shape and the C-order little-endian bytes of an array."""
-    a = np.ascontiguousarray(array, dtype=np.dtype(array.dtype).newbyteorder("<"))
-    h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
-    h.update(a.reshape(-1).view(np.uint8))  # the bytes in place: a copy of a plate is 257 MB
-    return h.hexdigest()
-
-
-def attributes_sha256(attributes: dict) -> str:
-    """sha256 of an array's attributes as its ``zarr.json`` holds them (canonical JSON:
-    sorted keys, no spaces), the same for the dict written and the one read back."""
-    return canonical_sha256(attributes)
-
-
-def check_attributes(attributes: dict, expected: str | None, label: str, path: str) -> None:
-    """Raise :class:`CollectionError` if ``attributes`` are not the ones whose sha256 is
-    ``expected`` (None: not recorded, in collections written before it was)."""
-    if expected is not None and attributes_sha256(attributes) != expected:
-        raise CollectionError(f"{label}: {path} attributes do not match their sha256 (its zarr.json was edited "
-                              "or damaged)")
-
-
-def _fingerprint(root: Path, path: str) -> tuple:
-    """What identifies one version of an array's files: names, inodes, sizes, mtimes."""
-    folder = root / RADIANCE_STORE / path
-    files = []
-    for p in sorted(folder.rglob("*")):
-        if p.is_file():
-            st = p.stat()
-            files.append((str(p.relative_to(folder)), st.st_ino, st.st_size, st.st_mtime_ns))
-    return (str(folder.resolve()), *files)
 
 
 def _lamps_on(spec: TargetedCondition) -> dict[str, float]:
@@ -138,90 +90,6 @@ def remember_group_luminances(values: dict[tuple, float]) -> None:
     (:meth:`Collection.group_luminances`): the same keys (a file's version included), so a
     changed file is measured again, and the same floats, so the same weights and bytes."""
     _GROUP_LUMINANCE.update(values)
-
-
-def read_checked(root: Path, group, path: str, expected: str | None, label: str,
-                 expected_attributes: str | None = None) -> tuple[np.ndarray, dict]:
-    """Read one array of a collection and its attributes; check it against ``expected``
-    (its recorded sha256; None for masks of older collections, which have none) and its
-    attributes against ``expected_attributes`` (:func:`attributes_sha256`; None for
-    collections written before it was recorded).
-
-    Raises :class:`CollectionError` ``"<label>: <path> <what is wrong>"`` if the array is
-    missing, unreadable, or not the bytes that were written (a deleted chunk reads as
-    fill values, so it fails the hash too), or if its attributes were changed.
-    """
-    import zarr
-
-    try:
-        node = group[path]
-    except KeyError:
-        raise CollectionError(f"{label}: {path} is missing") from None
-    except Exception as exc:  # its zarr.json is damaged
-        raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
-    if not isinstance(node, zarr.Array):
-        raise CollectionError(f"{label}: {path} is missing (a group is in its place)")
-    fingerprint = _fingerprint(root, path) + (expected,)
-    try:
-        data = np.asarray(node[...])
-        attrs = dict(node.attrs)
-    except Exception as exc:  # zstd, numcodecs and zarr raise many types for a damaged chunk
-        raise CollectionError(f"{label}: {path} is unreadable ({type(exc).__name__})") from None
-    basis = None
-    if "spectral_basis" in attrs:  # K coefficients per pixel: the radiance is decoded (store.spectral_basis)
-        try:
-            basis = np.asarray(attrs["spectral_basis"], dtype=np.float64)
-        except (TypeError, ValueError):
-            basis = None
-        bands = len(attrs.get("wavelengths_nm") or ())
-        if basis is None or basis.ndim != 2 or data.ndim != 3 or basis.shape != (data.shape[-1], bands):
-            raise CollectionError(f"{label}: {path} is unreadable (its spectral_basis does not fit its coefficients)")
-    check_attributes(attrs, expected_attributes, label, path)  # (after the basis' shape: the more telling error)
-    if basis is not None:
-        data = decode(data, basis.T)
-    if expected is not None and fingerprint not in _CHECKED:
-        if array_sha256(data) != expected:
-            has_chunk = any(name != "zarr.json" for name, *_ in fingerprint[1:-1])
-            raise CollectionError(f"{label}: {path} does not match its sha256"
-                                  + ("" if has_chunk else " (its chunk is missing)"))
-        _CHECKED.add(fingerprint)
-    return data, attrs
-
-
-def _radiance_shape(arr) -> tuple[int, int, int]:
-    """(rows, cols, bands) of a radiance array as a reader gets it, from its metadata (an array
-    stored through a spectral basis holds K coefficients per pixel, not its bands)."""
-    return (*arr.shape[:2], len(arr.attrs.get("wavelengths_nm", ())) or arr.shape[2])
-
-
-def _extent(attrs: dict, label: str, path: str) -> TanExtent:
-    try:
-        return TanExtent(*(float(v) for v in attrs["extent_tan"]))
-    except (KeyError, TypeError, ValueError):
-        raise CollectionError(f"{label}: {path} has no valid extent_tan attribute") from None
-
-
-def file_in_the_way(out_dir: str | Path, what: str = "--out") -> str | None:
-    """Why ``out_dir`` cannot be a folder (it is a file, or a path through one), or None;
-    ``what``: the option that named it."""
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        return f"{what} {out_dir} is a file, not a folder"
-    for parent in out_dir.absolute().parents:
-        if parent.exists():
-            return None if parent.is_dir() else f"{what} {out_dir}: {parent} is a file, not a folder"
-    return None
-
-
-def collection_containing(path: str | Path) -> Path | None:
-    """The collection folder that ``path`` is (or lies inside), or None. A folder is a
-    collection if it holds a resolved manifest, a radiance store or a generate stamp."""
-    p = Path(os.path.abspath(Path(path).expanduser())).resolve()
-    for folder in (p, *p.parents):
-        if ((folder / RESOLVED_MANIFEST_FILE).is_file() or (folder / RADIANCE_STORE).is_dir()
-                or (folder / PROGRESS_DIR / "manifest_sha256").is_file()):
-            return folder
-    return None
 
 
 @dataclass(frozen=True)
@@ -709,141 +577,3 @@ class Collection:
     def verify(self) -> list[str]:
         """Every problem of the collection, one line each naming its scene (or plate)."""
         return verify_collection(self.root)
-
-
-def _load_resolved(root: Path) -> ResolvedManifest:
-    """The resolved manifest, parsed and checked against its own hashes (the manifest it
-    holds is parsed by :func:`_parse_manifest`)."""
-    try:
-        resolved = yaml.safe_load((root / RESOLVED_MANIFEST_FILE).read_text())
-    except (OSError, yaml.YAMLError, UnicodeDecodeError) as exc:
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} is corrupted ({type(exc).__name__})") from None
-    if (not isinstance(resolved, dict) or not isinstance(resolved.get("manifest"), dict)
-            or not isinstance(resolved.get("arrays"), dict) or "manifest_sha256" not in resolved):
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} lacks 'manifest', 'manifest_sha256' or 'arrays'")
-    if manifest_sha256(resolved["manifest"]) != resolved["manifest_sha256"]:
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: its manifest does not match manifest_sha256 "
-                              "(edited or damaged)")
-    content = resolved.get("content_sha256")  # absent in collections written before it
-    if content is not None and content != resolved_content_sha256(resolved):
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE} does not match its content_sha256 (edited or damaged)")
-    attributes = resolved.get("attributes_sha256")  # absent in collections written before it
-    if attributes is not None and not (isinstance(attributes, dict)
-                                       and all(isinstance(v, str) for v in attributes.values())):
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: attributes_sha256 is not a mapping of hashes")
-    groups = resolved.get("light_groups")  # absent where the collection holds all of its manifest's
-    if groups is not None and not (isinstance(groups, list) and all(isinstance(g, str) for g in groups)):
-        raise CollectionError(f"{root}: {RESOLVED_MANIFEST_FILE}: light_groups is not a list of light groups")
-    return ResolvedManifest.from_dict(resolved)
-
-
-def _parse_manifest(root: Path, resolved: ResolvedManifest) -> Manifest:
-    """The manifest a collection was rendered from, validated as a manifest file is."""
-    try:
-        return parse_manifest(resolved.manifest_json, source=RESOLVED_MANIFEST_FILE)
-    except ManifestError as exc:
-        raise CollectionError(f"{root}: {exc}") from None
-
-
-def _load_groundtruth(root: Path) -> tuple[dict, str]:
-    """The COCO ground truth and the sha256 of its file's bytes."""
-    try:
-        raw = (root / GROUNDTRUTH_FILE).read_bytes()
-        groundtruth = json.loads(raw)
-    except (OSError, ValueError, UnicodeDecodeError) as exc:
-        raise CollectionError(f"{root}: {GROUNDTRUTH_FILE} is corrupted ({type(exc).__name__})") from None
-    try:
-        ok = (all({"scene_id", "id", "environment_id", "distance_m", "width", "height"} <= set(i)
-                  for i in groundtruth["images"])
-              and all({"image_id", "bbox"} <= set(a) for a in groundtruth["annotations"]))
-    except (KeyError, TypeError):
-        ok = False
-    if not ok:
-        raise CollectionError(f"{root}: {GROUNDTRUTH_FILE} is not a collection's COCO ground truth")
-    return groundtruth, hashlib.sha256(raw).hexdigest()
-
-
-def _progress_arrays(root: Path) -> tuple[dict[str, str], dict[str, str]]:
-    """The array hashes and attribute hashes the progress records hold (what verify falls
-    back on when the resolved manifest is unusable)."""
-    arrays, attributes = {}, {}
-    for record in sorted((root / PROGRESS_DIR).glob("*.json")):
-        try:
-            data = json.loads(record.read_text())
-            arrays.update(data["arrays"])
-            attributes.update(data.get("attributes") or {})
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            continue
-    return arrays, attributes
-
-
-def upgrade_notes(path: str | Path) -> list[str]:
-    """What an intact collection written by an older version does not record yet, and how to
-    record it (one line each): its arrays' attribute hashes."""
-    try:
-        resolved = _load_resolved(Path(path))
-    except CollectionError:
-        return []
-    return [ATTRIBUTES_UPGRADE_NOTE] if resolved.attributes_sha256 is None and resolved.arrays else []
-
-
-def unfinished_generation(root: str | Path) -> str | None:
-    """What a collection whose ``generate`` has not finished holds so far (units recorded in
-    ``progress/``; the resolved manifest and ground truth come after the last), else None."""
-    root = Path(root)
-    if (root / RESOLVED_MANIFEST_FILE).exists() or not (root / PROGRESS_DIR).is_dir():
-        return None
-    done = len(list((root / PROGRESS_DIR).glob("*.json")))
-    return (f"its generation has not finished ({done} units done; {RESOLVED_MANIFEST_FILE} and {GROUNDTRUTH_FILE} "
-            "are written after the last): rerun `metricscenes generate` to finish it")
-
-
-def verify_collection(path: str | Path) -> list[str]:
-    """Check a whole collection; return every problem, one line each naming its scene
-    (plates: their environment): the resolved manifest (parses, manifest and content
-    hashes), every recorded array (sha256; masks too), and the ground truth (sha256, plan,
-    boxes recomputed from the masks), every array's attributes (their recorded sha256,
-    where the collection records them). Empty: nothing is wrong."""
-    import zarr
-
-    root = Path(path)
-    if not root.is_dir():
-        return [f"{root}: no such collection folder"]
-    resolved = groundtruth = None
-    unfinished = unfinished_generation(root)
-    problems = [unfinished] if unfinished else []  # (then its units' arrays are checked against their records)
-    try:
-        if not unfinished:
-            resolved = _load_resolved(root)
-            _parse_manifest(root, resolved)
-    except CollectionError as exc:
-        problems.append(str(exc).removeprefix(f"{root}: "))
-    try:
-        if not unfinished or (root / GROUNDTRUTH_FILE).exists():
-            groundtruth = _load_groundtruth(root)
-    except CollectionError as exc:
-        problems.append(str(exc).removeprefix(f"{root}: "))
-    if resolved is not None:
-        expected, attributes = resolved.arrays, resolved.attributes_sha256
-        fallback = ""  # it records them: an array it lists without them fails the check
-    else:
-        expected, attributes = _progress_arrays(root)
-        fallback = None  # what the records hold; older records hold none
-    if not expected:
-        problems.append("no recorded array hashes to check (manifest.resolved.yaml and progress/ are unusable)")
-    try:
-        group = zarr.open_group(str(root / RADIANCE_STORE), mode="r")
-    except Exception as exc:
-        return [*problems, f"{RADIANCE_STORE} is missing or unreadable ({type(exc).__name__})"]
-    for array_path, sha in sorted(expected.items()):
-        kind, _, rest = array_path.partition("/")
-        unit = rest.split("/")[0]
-        try:
-            read_checked(root, group, array_path, sha, f"environment {unit}" if kind == "plates" else f"scene {unit}",
-                         None if attributes is None else attributes.get(array_path, fallback))
-        except CollectionError as exc:
-            problems.append(str(exc))
-    if groundtruth is not None:  # without a usable resolved manifest, boxes are still checked against the masks
-        problems += groundtruth_problems(root, group, *groundtruth, resolved)
-    # A mask listed by its array hash and by the ground-truth check is one problem.
-    return list(dict.fromkeys(problems))
