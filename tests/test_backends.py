@@ -120,6 +120,25 @@ def _sweep_files(folder: Path) -> dict[str, bytes]:
     return files
 
 
+def sweep_serial_and_pooled(collection, condition: str, tmp_path: Path):
+    """Two small cameras of different f-numbers (fast) swept under ``condition`` with one and
+    with two workers, into ``tmp_path/serial`` and ``tmp_path/pooled``: (cameras, the two tables)."""
+    from benchmark.camera import load_camera
+    from benchmark.detectors import load_detector
+    from benchmark.experiments.sweep import sweep
+
+    spec = tmp_path / "small.yaml"
+    spec.write_text("name: small\noptics: {f_number: 2.0}\nsensor: {pixel_um: 11.2}\n")
+    twin = tmp_path / "small-f4.yaml"
+    twin.write_text("name: small-f4\noptics: {f_number: 4.0}\nsensor: {pixel_um: 8.4}\n")
+    cameras = [load_camera(spec), load_camera(twin)]
+    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
+    options = dict(n_resamples=20, mtf_source="analytic")
+    serial = sweep(collection, cameras, [condition], detector, tmp_path / "serial", **options)
+    pooled = sweep(collection, cameras, [condition], detector, tmp_path / "pooled", workers=2, **options)
+    return cameras, serial, pooled
+
+
 def _small_cameras(folder: Path) -> list:
     """Two cameras of 240 x 135 and 320 x 180 px: a sweep of the tiny collection in seconds."""
     from benchmark.camera import load_camera

@@ -12,7 +12,8 @@ from benchmark.camera import optics as _optics
 from benchmark.camera import sensor as _sensor
 from benchmark.camera.pipeline import FieldOfViewError, camera_extent, camera_window, electron_rate
 from benchmark.camera import camera_from_dict, list_cameras, load_camera
-from benchmark.experiments.run import camera_geometry, collection_field, run_camera
+from benchmark.experiments.collection_view import camera_geometry, collection_field
+from benchmark.experiments.run import run_camera
 from metricscenes.geometry import (
     HORIZONTAL_FOV_DEG,
     REFERENCE_EXTENT,

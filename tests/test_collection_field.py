@@ -10,7 +10,7 @@ import pytest
 
 from benchmark.camera.pipeline import FieldOfViewError, camera_window
 from benchmark.camera import camera_from_dict
-from benchmark.experiments.run import collection_field
+from benchmark.experiments.collection_view import collection_field
 from metricscenes.geometry import REFERENCE_EXTENT, field_extent, fov_deg
 from metricscenes.groundtruth import box_tan_to_xywh, car_box_tan
 from metricscenes.manifest import ManifestError, canonical_sha256, load_manifest, parse_manifest

@@ -16,6 +16,15 @@ SHA = "f" * 64
 NIGHT = condition_label("night")  # verdicts open with what the condition physically is
 
 
+def _write_run(folder, camera: str, condition: str, gt: dict, detections: list, manifest_sha256: str = SHA):
+    """A minimal run folder ``compare`` reads: results.json, groundtruth.json, detections.json."""
+    folder.mkdir()
+    results = {"camera": {"name": camera}, "condition": condition, "collection": {"manifest_sha256": manifest_sha256}}
+    (folder / "results.json").write_text(json.dumps(results))
+    (folder / "groundtruth.json").write_text(json.dumps(gt))
+    (folder / "detections.json").write_text(json.dumps(detections))
+
+
 def side(gt, dets, name="camA", condition="day", sha=SHA, folder="run") -> Side:
     from pathlib import Path
 
@@ -101,12 +110,7 @@ def test_cli_runs_and_refuses_in_one_line(tmp_path, run20):
 
     gt, dets = run20
     for name, d, sha in (("a", dets, SHA), ("b", degraded(gt, dets), SHA), ("c", dets, "0" * 64)):
-        folder = tmp_path / name
-        folder.mkdir()
-        results = {"camera": {"name": f"cam-{name}"}, "condition": "day", "collection": {"manifest_sha256": sha}}
-        (folder / "results.json").write_text(json.dumps(results))
-        (folder / "groundtruth.json").write_text(json.dumps(gt))
-        (folder / "detections.json").write_text(json.dumps(d))
+        _write_run(tmp_path / name, f"cam-{name}", "day", gt, d, sha)
     runner = CliRunner()
     out = tmp_path / "cmp"
     res = runner.invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "50", "--out", str(out)])
@@ -165,12 +169,7 @@ def test_cli_says_both_blind(tmp_path):
 
     gt, _ = synthetic_collection(10, seed=7)
     for name, dets in zip(("a", "b"), _blind_beyond_25m(gt)):
-        folder = tmp_path / name
-        folder.mkdir()
-        results = {"camera": {"name": f"cam-{name}"}, "condition": "night", "collection": {"manifest_sha256": SHA}}
-        (folder / "results.json").write_text(json.dumps(results))
-        (folder / "groundtruth.json").write_text(json.dumps(gt))
-        (folder / "detections.json").write_text(json.dumps(dets))
+        _write_run(tmp_path / name, f"cam-{name}", "night", gt, dets, SHA)
     before = sorted(p.name for p in tmp_path.rglob("*"))
     res = CliRunner().invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "100"])
     assert res.exit_code == 0, res.output
@@ -218,12 +217,7 @@ def test_cli_refuses_on_two_environments_and_prints_the_table(tmp_path):
 
     gt, _ = synthetic_collection(2, seed=7)
     for name, dets in (("a", _perfect(gt)), ("b", _perfect(gt, 50.0))):
-        folder = tmp_path / name
-        folder.mkdir()
-        results = {"camera": {"name": f"cam-{name}"}, "condition": "day", "collection": {"manifest_sha256": SHA}}
-        (folder / "results.json").write_text(json.dumps(results))
-        (folder / "groundtruth.json").write_text(json.dumps(gt))
-        (folder / "detections.json").write_text(json.dumps(dets))
+        _write_run(tmp_path / name, f"cam-{name}", "day", gt, dets, SHA)
     res = CliRunner().invoke(app, ["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--resamples", "50"],
                              env={"COLUMNS": "250"})
     assert res.exit_code == 0, res.output

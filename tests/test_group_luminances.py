@@ -3,7 +3,7 @@ scene's photometric target) measured once per scene for a whole sweep, shared wi
 
 import pytest
 
-from conftest import model_dir, require_model
+from conftest import require_model
 
 
 @pytest.fixture(autouse=True)
@@ -49,19 +49,8 @@ def test_no_target_no_measuring(smoke_collection, monkeypatch):
 @pytest.mark.slow
 def test_a_targeted_sweeps_bytes_do_not_depend_on_the_workers(smoke_collection, tmp_path):
     require_model("yolov5n-dynamic.onnx")
-    from benchmark.camera import load_camera
-    from benchmark.detectors import load_detector
-    from benchmark.experiments.sweep import sweep
-    from test_backends import _sweep_files
+    from test_backends import _sweep_files, sweep_serial_and_pooled
 
-    spec = tmp_path / "small.yaml"
-    spec.write_text("name: small\noptics: {f_number: 2.0}\nsensor: {pixel_um: 11.2}\n")
-    twin = tmp_path / "small-f4.yaml"
-    twin.write_text("name: small-f4\noptics: {f_number: 4.0}\nsensor: {pixel_um: 8.4}\n")
-    cameras = [load_camera(spec), load_camera(twin)]
-    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
-    options = dict(n_resamples=20, mtf_source="analytic")
-    serial = sweep(smoke_collection, cameras, ["night"], detector, tmp_path / "serial", **options)
-    pooled = sweep(smoke_collection, cameras, ["night"], detector, tmp_path / "pooled", workers=2, **options)
+    _, serial, pooled = sweep_serial_and_pooled(smoke_collection, "night", tmp_path)
     assert serial.equals(pooled)
     assert _sweep_files(tmp_path / "pooled") == _sweep_files(tmp_path / "serial")

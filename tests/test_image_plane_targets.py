@@ -266,24 +266,13 @@ def test_capture_key_holds_a_read_time_conditions_definition_and_nothing_new_for
 def test_a_sweep_records_each_cameras_weights_the_same_with_any_workers(lab_smoke, tmp_path):
     """Two small cameras of different f-numbers (fast), one and two workers: the same files."""
     require_model("yolov5n-dynamic.onnx")
-    from test_backends import _sweep_files
+    from test_backends import _sweep_files, sweep_serial_and_pooled
 
-    from benchmark.camera import load_camera
-    from benchmark.detectors import load_detector
     from benchmark.experiments.keys import capture_key, results_capture_key
-    from benchmark.experiments.sweep import sweep
     from benchmark.result_files import read_results
     from metricscenes.store import Collection
 
-    spec = tmp_path / "small.yaml"
-    spec.write_text("name: small\noptics: {f_number: 2.0}\nsensor: {pixel_um: 11.2}\n")
-    twin = tmp_path / "small-f4.yaml"
-    twin.write_text("name: small-f4\noptics: {f_number: 4.0}\nsensor: {pixel_um: 8.4}\n")
-    cameras = [load_camera(spec), load_camera(twin)]
-    detector = load_detector("yolov5n-dynamic", input_size="native", model_dir=model_dir())
-    options = dict(n_resamples=20, mtf_source="analytic")
-    sweep(Collection.open(lab_smoke), cameras, ["night_lab"], detector, tmp_path / "serial", **options)
-    sweep(Collection.open(lab_smoke), cameras, ["night_lab"], detector, tmp_path / "pooled", workers=2, **options)
+    cameras, _, _ = sweep_serial_and_pooled(lab_smoke, "night_lab", tmp_path)  # each sweep opens it afresh
     assert _sweep_files(tmp_path / "pooled") == _sweep_files(tmp_path / "serial")
     collection = Collection.open(lab_smoke)
     small, fast = (read_results(tmp_path / "serial" / "runs" / f"{c.name}-night_lab" / "results.json")

@@ -38,10 +38,8 @@ def app():
 
 
 @pytest.fixture(scope="module")
-def manifest():
-    from metricscenes.manifest import load_manifest
-
-    return load_manifest(REPO / "manifests" / "smoke.yaml")
+def manifest(smoke_manifest):
+    return smoke_manifest
 
 
 @pytest.fixture(scope="module")

@@ -111,7 +111,8 @@ def fake_run_camera(collection, camera, condition, detector, out_dir, *, seed=0,
     assert captures is None, "fake_run_camera does not read another sweep's captures"
     from PIL import Image, ImageDraw
 
-    from benchmark.experiments.run import COMPOSITE, sha256_bytes
+    from benchmark.experiments.collection_view import COMPOSITE
+    from benchmark.experiments.run import sha256_bytes
     from benchmark.result_files import RunResults, write_results
     from metricscenes.groundtruth import scale_groundtruth
 

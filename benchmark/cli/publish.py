@@ -26,6 +26,13 @@ def _names(text: str) -> list[str]:
     return [name for name in text.split(",") if name]
 
 
+def _write_and_print(table, out: Path | None, text: str) -> None:
+    """A paired-bootstrap table to ``out`` (CSV, 4 decimals, as docs/data keeps them) if given, and its report printed."""
+    if out:
+        table.to_csv(out, index=False, float_format="%.4f")
+    print(text)
+
+
 @app.command()
 def sweeps(
     results: Annotated[Path, typer.Option(help="folder holding the sweep folders")] = Path("results"),
@@ -63,9 +70,7 @@ def mtf50_groups(
     from benchmark.publish.mtf50_groups import compare_groups, report
 
     table, lines = compare_groups(sweep, _names(conditions), resamples, seed)
-    if out:
-        table.to_csv(out, index=False, float_format="%.4f")
-    print(report(table, lines))
+    _write_and_print(table, out, report(table, lines))
 
 
 @app.command("camera-variants")
@@ -83,9 +88,7 @@ def camera_variants(
     from benchmark.publish.camera_variants import compare_variants, report
 
     table, lines = compare_variants(reference, variants, _names(cameras), _names(conditions), against, resamples, seed)
-    if out:
-        table.to_csv(out, index=False, float_format="%.4f")
-    print(report(table, lines, against))
+    _write_and_print(table, out, report(table, lines, against))
 
 
 @app.command("backend-scores")
@@ -107,9 +110,7 @@ def backend_scores(
         more_rows, more_lines = compare_backends(gpu, cpu, condition, resamples, seed)
         rows += more_rows
         lines += more_lines
-    if out:
-        pd.DataFrame(rows).to_csv(out, index=False, float_format="%.4f")
-    print("\n".join([HEADER, *lines]))
+    _write_and_print(pd.DataFrame(rows), out, "\n".join([HEADER, *lines]))
 
 
 @app.command("mtf50-isp")

@@ -27,10 +27,10 @@ def camera_geometry(collection, camera) -> dict | None:
     from benchmark.camera.pipeline import camera_window
 
     field = collection_field(collection)
-    return _geometry_record(camera, field, camera_window(camera, field))
+    return geometry_record(camera, field, camera_window(camera, field))
 
 
-def _geometry_record(camera, field, window) -> dict | None:
+def geometry_record(camera, field, window) -> dict | None:
     """:func:`camera_geometry` of a camera whose window of ``field`` is known."""
     from metricscenes.geometry import fov_deg
 

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from benchmark.experiments.collection_view import COMPOSITE, camera_geometry, condition_spec
+
 if TYPE_CHECKING:
     from benchmark.result_files import RunResults
 
@@ -39,7 +41,6 @@ def capture_key(camera, condition: str, collection, seed: int) -> dict:
     """What makes two runs' camera images interchangeable: camera spec sha256, condition,
     collection manifest sha256, seed, and the camera's geometry and the collection subset
     where present (the detector is not part of it)."""
-    from benchmark.experiments.collection_view import COMPOSITE, camera_geometry, condition_spec
 
     key = {"camera_spec_sha256": camera.sha256(), "condition": condition,
            "manifest_sha256": collection.manifest_sha256, "seed": int(seed), "composite": COMPOSITE}

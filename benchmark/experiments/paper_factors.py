@@ -244,7 +244,7 @@ def run_factors(collection, cameras, out_dir, *, base_name: str = "night", which
     from benchmark.camera.pipeline import lens_mapping
     from benchmark.detectors.registry import resolve_model, verify_sha256
     from benchmark.experiments.keys import factor_unit_key
-    from benchmark.experiments.run import collection_field
+    from benchmark.experiments.collection_view import collection_field
     from benchmark.experiments.subset import parse_subset
     from metricscenes.backends import map_units, threads_per_unit
     from metricscenes.store import scale_groundtruth

@@ -9,7 +9,7 @@ The chain, each stage from its own module: collection radiance (metricscenes sto
 - ``detections.json``: every detection (score ≥ 0.001) in COCO results format, boxes in
   the camera's pixels;
 - ``groundtruth.json``: the collection's ground truth on the camera's grid (scaled, or
-  mapped onto the camera's window of the field: :func:`camera_geometry`);
+  mapped onto the camera's window of the field: :func:`benchmark.experiments.collection_view.camera_geometry`);
 - ``images/<scene>.png``: the camera's sRGB images (optional), and ``images.sha256``, the
   sha256 of each (``sha256sum`` format). Runs that share an image hold it as one file (hard
   links), so a write over it in one folder changes it in all of them: a run that reads images
@@ -43,9 +43,7 @@ import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
 from benchmark.experiments.keys import capture_key, grid_key, results_capture_key, resume_key
-from benchmark.experiments.collection_view import (  # noqa: F401 (named here too: run's API)
-    COMPOSITE, _geometry_record, camera_geometry, collection_field, condition_spec,
-)
+from benchmark.experiments.collection_view import COMPOSITE, collection_field, condition_spec, geometry_record
 from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
     CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
 )
@@ -471,7 +469,7 @@ class _CameraRun:
         from metricscenes import __version__
 
         collection, camera, timings = self.collection, self.camera, self.timings
-        geometry = _geometry_record(camera, self.field, self.window)
+        geometry = geometry_record(camera, self.field, self.window)
         t = time.perf_counter()
         per_distance = ap_by_distance(groundtruth, detections, backend=self.backend)
         working = working_point(groundtruth, detections)  # miss rate and false positives per image beside AP

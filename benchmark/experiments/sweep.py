@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
+from benchmark.experiments.collection_view import collection_field
 from benchmark.experiments.keys import results_key, run_key
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
@@ -305,7 +306,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
     names = [c.name for c in cameras]
     if len(set(names)) != len(names):
         raise ValueError(f"camera names must be unique, got {names}")
-    field = run_module.collection_field(collection)
+    field = collection_field(collection)
     for camera in cameras:  # every run folder name and camera field is valid before anything is written
         camera_window(camera, field)
         for condition in conditions:

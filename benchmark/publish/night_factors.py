@@ -33,7 +33,8 @@ from benchmark.camera.exposure import parse_exposure, with_exposure
 from benchmark.camera.isp import encode_srgb8
 from benchmark.camera.pipeline import lens_mapping, simulate
 from benchmark.coco import coco_category_id
-from benchmark.experiments.run import collection_field, scene_seed
+from benchmark.experiments.collection_view import collection_field
+from benchmark.experiments.run import scene_seed
 from benchmark.experiments.subset import subset_collection
 from benchmark.publish.night_exposure import green_sites
 from benchmark.scoring import AP_SCORE_THRESHOLD, ap_by_distance

@@ -40,7 +40,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
 
-    from benchmark.experiments.run import COMPOSITE
+    from benchmark.experiments.collection_view import COMPOSITE
     from metricscenes.radiance import band_planes
     from metricscenes.store import Collection
 

@@ -31,7 +31,7 @@ def main() -> None:
     from benchmark.camera import camera_names, load_camera
     from benchmark.camera.pipeline import camera_window, sensor_extent
     from benchmark.experiments.keys import grid_key
-    from benchmark.experiments.run import COMPOSITE
+    from benchmark.experiments.collection_view import COMPOSITE
     from metricscenes.store import Collection
 
     collection = Collection.open(args.collection)
