@@ -80,15 +80,9 @@ def blind_below(n_cars: int) -> int:
     return min(cars_needed(n_cars), max(1, math.ceil(n_cars / 2)))
 
 
-def found_cars(side: "Side") -> dict[float, tuple[int, int]]:
-    """Per distance: (cars found, cars) of one run (:data:`FOUND_SCORE`, :data:`FOUND_IOU`)."""
-    return {d: (r["detected"], r["n_images"]) for d, r in working_rows(side).items()}
-
-
 def working_rows(side: "Side") -> dict[float, dict]:
     """Per distance: :func:`benchmark.scoring.detection_rates` of one run at the working threshold."""
-    rows = detection_rates(side.groundtruth, side.detections, score_threshold=FOUND_SCORE, iou_threshold=FOUND_IOU)
-    return {float(r["distance_m"]): r for r in rows}
+    return {float(r["distance_m"]): r for r in detection_rates(side.groundtruth, side.detections)}
 
 
 class CompareError(ValueError):
