@@ -10,13 +10,13 @@ import gzip
 import hashlib
 import json
 import math
-import os
 import shutil
 from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
+from conftest import require_model
 from benchmark.leaderboard import (
     NoDetectionsWarning, SubmissionError, check_submission_file, dumps_submission, load_protocols, pack_path,
     read_pack, save_submission, tree_sha256, write_submission,
@@ -274,9 +274,7 @@ def test_compare_with_a_reference_from_the_cli_and_its_refusals(board, runs, tmp
 def test_a_smoke_run_compared_with_a_submission_that_ships_its_detections(smoke_collection, tmp_path):
     """Two cameras run on the smoke collection; one is submitted (with its detections) and --check
     recomputes its AP; the other compared with that submission is its comparison with the run."""
-    model_dir = Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
-    if not (model_dir / "yolov5n-dynamic.onnx").is_file():
-        pytest.skip(f"yolov5n-dynamic.onnx not found in METRICSCENES_MODEL_DIR={model_dir}")
+    model_dir = require_model("yolov5n-dynamic.onnx").parent
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
     from benchmark.experiments.compare import compare_paths

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import shutil
 from pathlib import Path
 
 import jsonschema
 import pytest
 from typer.testing import CliRunner
+
+from conftest import require_model
 
 from benchmark.leaderboard import (
     SubmissionError,
@@ -266,9 +267,7 @@ def test_interrupted_render_leaves_the_old_table(app, populated, monkeypatch):
 @pytest.mark.slow
 def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
     """Run a camera on the smoke collection, submit, check, render: the table shows its OD50."""
-    model_dir = Path(os.environ.get("METRICSCENES_MODEL_DIR", REPO.parent / "shared" / "models"))
-    if not (model_dir / "yolov5n-dynamic.onnx").is_file():
-        pytest.skip(f"yolov5n-dynamic.onnx not found in METRICSCENES_MODEL_DIR={model_dir}")
+    model_dir = require_model("yolov5n-dynamic.onnx").parent
     from benchmark.camera import load_camera
     from benchmark.detectors import load_detector
     from benchmark.experiments.run import run_camera
