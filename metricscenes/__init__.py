@@ -18,5 +18,8 @@ except PackageNotFoundError:  # running from a source tree without install
 
 from metricscenes.radiance import RadianceLayer, SpectralScene  # noqa: E402
 from metricscenes.spectral import WAVELENGTHS_NM  # noqa: E402
+from metricscenes.numeric_pins import pin_blas_threads  # noqa: E402
+
+pin_blas_threads()  # numpy is loaded now
 
 __all__ = ["__version__", "WAVELENGTHS_NM", "RadianceLayer", "SpectralScene"]

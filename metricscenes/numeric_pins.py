@@ -11,6 +11,11 @@ load, so this module sets it before numpy is imported:
   every AVX-512 CPU has too; elsewhere OpenBLAS keeps its own choice, recorded.
 - ``NPY_DISABLE_CPU_FEATURES`` += the AVX-512 groups (numpy then dispatches to its AVX2
   kernels, as on an AVX2 machine).
+- OpenBLAS on one thread (``OPENBLAS_NUM_THREADS=1``, and :func:`pin_blas_threads` once numpy
+  is loaded): a threaded matrix product splits its columns by thread, and the columns at a
+  split's edge take a tail kernel that sums in another order, so a 1 × 31 by 31 × N product
+  changes in the last bit between one and two threads (measured: 3 of 32 400 values). dask's
+  workers run OpenBLAS on one thread, so a serial run must too for its bytes to match a pooled one.
 
 A value the user set is kept. What cannot be pinned from Python — Mitsuba's ray tracer
 (Embree picks its AVX2 or AVX-512 kernels itself) and onnxruntime's CPU kernels (MLAS,
@@ -27,6 +32,7 @@ import sys
 from importlib.metadata import PackageNotFoundError, version
 
 OPENBLAS_CORETYPE = "Haswell"
+BLAS_THREADS = "1"
 NUMPY_AVX512_GROUPS = ("X86_V4", "AVX512_ICL", "AVX512_SPR")
 BYTE_DECIDING_PACKAGES = ("mitsuba", "drjit", "numpy", "scipy", "onnxruntime", "zarr", "numcodecs",
                           "colour-science", "colour-demosaicing", "pillow", "faster-coco-eval", "pycocotools")
@@ -78,9 +84,17 @@ def pin_numeric_libraries(environ=os.environ) -> bool:
         return pins_hold(environ)
     if {"avx2", "fma"} <= cpu_flags():
         environ.setdefault("OPENBLAS_CORETYPE", OPENBLAS_CORETYPE)
+    environ["OPENBLAS_NUM_THREADS"] = BLAS_THREADS  # not the user's: bytes must not depend on it
     disabled = environ.get("NPY_DISABLE_CPU_FEATURES", "").replace(",", " ").split()
     environ["NPY_DISABLE_CPU_FEATURES"] = " ".join(dict.fromkeys(disabled + list(NUMPY_AVX512_GROUPS)))
     return pins_hold(environ)
+
+
+def pin_blas_threads() -> None:
+    """OpenBLAS on one thread in this process, also where numpy was loaded before us."""
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=int(BLAS_THREADS), user_api="blas")
 
 
 def pins_hold(environ=os.environ) -> bool:

@@ -139,3 +139,19 @@ def test_cam12_day_run_is_golden(smoke_collection, golden_here, tmp_path):
         if golden_here["cam12_day_ap"]:
             assert ap == golden_here["cam12_day_ap"]
     assert ap_outside_tolerance(ap) == {}
+
+
+def test_blas_runs_on_one_thread_because_two_threads_change_a_products_last_bit():
+    """The pin is needed: a 1 × 31 by 31 × N float32 product differs between one and two
+    OpenBLAS threads (a split's edge columns take a tail kernel); metricscenes runs one."""
+    import numpy as np
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    blas = [i for i in threadpool_info() if i.get("internal_api") == "openblas"]
+    assert blas and all(i["num_threads"] == 1 for i in blas)
+    rng = np.random.default_rng(0)
+    weights, planes = rng.random((1, 31), np.float32), rng.random((31, 240 * 135), np.float32)
+    one = np.matmul(weights, planes)
+    with threadpool_limits(limits=2, user_api="blas"):
+        two = np.matmul(weights, planes)
+    assert not np.array_equal(one, two)
