@@ -75,3 +75,21 @@ def test_percentile_interval_with_unreachable_od50():
     lo, hi = percentile_interval(values, 0.95)
     assert lo == 102.0 and hi == np.inf
     assert percentile_interval(np.linspace(0, 100, 101), 0.9) == (5.0, 95.0)
+
+
+def test_one_runs_intervals_are_the_percentile_ones_widened_for_few_environments(monkeypatch):
+    """OD50's and the AP range's intervals: the percentile interval stretched about its point by
+    t_{n−1}(0.975)·√(n/(n − 1))/1.96 (1.22 on 10 environments); the SDs are the resamples' own."""
+    import benchmark.scoring.bootstrap as bootstrap_module
+    from benchmark.scoring.simultaneous import few_environments_scale, stretch
+
+    gt, dets = synthetic_collection(10, seed=2, half_range_m=110.0)
+    widened = bootstrap_od50(gt, dets, n_resamples=200)
+    monkeypatch.setattr(bootstrap_module, "few_environments_scale", lambda n, level=0.95: 1.0)
+    bare = bootstrap_od50(gt, dets, n_resamples=200)
+    scale = few_environments_scale(10)
+    assert widened.interval_scale == pytest.approx(scale) and 1.2 < scale < 1.23
+    assert widened.ci95_m == pytest.approx(stretch(bare.od50_m, *bare.ci95_m, scale))
+    assert widened.ap_range_ci95_m == pytest.approx(stretch(bare.ap_range_m, *bare.ap_range_ci95_m, scale))
+    assert (widened.sd_m, widened.ap_range_sd_m) == (bare.sd_m, bare.ap_range_sd_m)
+    assert widened.ci95_m[0] < bare.ci95_m[0] <= bare.od50_m <= bare.ci95_m[1] < widened.ci95_m[1]

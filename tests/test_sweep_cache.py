@@ -247,6 +247,19 @@ def test_od50_cache_without_ap_range_is_computed_again(tmp_path, monkeypatch):
     assert boot.ap_range_m is not None and json.loads((run / "od50.json").read_text()) == stored
 
 
+def test_od50_cache_with_unscaled_intervals_is_computed_again(tmp_path, monkeypatch):
+    """An od50.json written before intervals were widened for few environments (no
+    ``interval_scale``) is not reused: its intervals are the bare percentile ones."""
+    make_fake_sweep(tmp_path / "sw", monkeypatch, n_resamples=40)
+    run = tmp_path / "sw" / "runs" / "cam01-day"
+    stored = json.loads((run / "od50.json").read_text())
+    assert stored["od50"]["interval_scale"] > 1.0
+    old = {**stored, "od50": {k: v for k, v in stored["od50"].items() if k != "interval_scale"}}
+    (run / "od50.json").write_text(json.dumps(old, indent=1))
+    boot = sweep_module.run_od50(run, n_resamples=40, seed=0)
+    assert boot.interval_scale is not None and json.loads((run / "od50.json").read_text()) == stored
+
+
 def test_second_sweep_reuses_every_run(tmp_path, monkeypatch):
     first = CountingRun()
     t1 = make_fake_sweep(tmp_path / "sw", monkeypatch, run=first)

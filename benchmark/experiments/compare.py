@@ -12,8 +12,12 @@ both curves together and cancel in the difference, so the interval of ΔAP(d) = 
 and ΔOD50 = OD50_A − OD50_B is narrower than one from two independent bootstraps
 (``paired=False``, kept for comparison and tests). AP per distance of the full sets comes
 from :func:`benchmark.scoring.ap_by_distance` (faster-coco-eval); the resamples re-weight
-COCO's per-image matches (:func:`benchmark.scoring.bootstrap.weighted_ap`). Intervals are
-95 % percentile intervals; ± is the bootstrap SD.
+COCO's per-image matches (:func:`benchmark.scoring.bootstrap.weighted_ap`). ± is the
+bootstrap SD. The 95 % intervals hold *together*: ΔAP at every distance and the headline
+(ΔOD50, or the ΔAP range) are one family, each interval Student's t at the Bonferroni level
+times the bootstrap SD scaled for few environments, and ΔOD50's percentile interval is
+widened as much (:mod:`benchmark.scoring.simultaneous`), so a camera compared with itself
+reseeded is called different in few pairs, not in most (docs/scoring.md).
 
 **Censoring.** When A's or B's OD50 is censored (AP does not cross 0.5 inside the measured
 distances: "> 200 m" or "< 25 m"), ΔOD50 in metres is not measured: the verdict rests on the
@@ -57,6 +61,7 @@ from benchmark.scoring import (
     od50_censoring, sample_too_small_text, too_few,
 )
 from benchmark.scoring.bootstrap import BOOTSTRAP_RESAMPLES, _match_tables, percentile_interval, weighted_ap
+from benchmark.scoring.simultaneous import family_intervals
 from benchmark.suggest import did_you_mean
 
 COMPARE_FORMAT = "metricscenes-compare/1"
@@ -279,19 +284,21 @@ def compare_runs(
         d_range[k] = ap_range(distances, ap_ab[0]) - ap_range(distances, ap_ab[1])
     per_env = min(a.environments_per_distance, b.environments_per_distance)
     too_small = too_few(per_env)  # no call at all: the rows say what the interval alone would be
+    delta_ap = sides["a"]["ap"] - sides["b"]["ap"]
+    delta_range = float(sides["a"]["ap_range_m"] - sides["b"]["ap_range_m"])
+    family = family_intervals(np.append(delta_ap, delta_range), np.column_stack([d_ap, d_range]), n, confidence_level)
     per_distance = []
     working = {"a": working_rows(a), "b": working_rows(b)}
     empty = {"detected": 0, "n_images": 0, "miss_rate": None, "false_positives_per_image": None}
     for j, dm in enumerate(distances):
-        col = d_ap[:, j][np.isfinite(d_ap[:, j])]
-        delta = float(sides["a"]["ap"][j] - sides["b"]["ap"][j])
-        lo, hi = enclose(delta, *percentile_interval(col, confidence_level))
+        delta = float(delta_ap[j])
+        lo, hi = family.interval(j, delta)
         wa, wb = working["a"].get(float(dm), empty), working["b"].get(float(dm), empty)
         found_a, n_cars, found_b = int(wa["detected"]), int(wa["n_images"]), int(wb["detected"])
         needed = cars_needed(n_cars)
         backed = (found_a if delta > 0 else found_b) >= needed  # the higher AP rests on found cars
         per_distance.append({"distance_m": float(dm), "ap_a": float(sides["a"]["ap"][j]), "ap_b": float(sides["b"]["ap"][j]),
-                             "delta_ap": delta, "sd": float(np.std(col, ddof=1)) if col.size > 1 else None,
+                             "delta_ap": delta, "sd": float(family.sd[j]),
                              "ci95": [lo, hi], "n_cars": n_cars, "found_a": found_a, "found_b": found_b,
                              "cars_needed": needed, "blind_below": blind_below(n_cars),
                              "resolved": bool((lo > 0 or hi < 0) and backed and not too_small),
@@ -305,11 +312,15 @@ def compare_runs(
     if censored:
         od_block = {"delta_m": None, "sd_m": None, "ci95_m": [None, None]}
     else:
-        lo, hi = enclose(delta_od, *percentile_interval(d_od[~np.isnan(d_od)], confidence_level))
-        od_block = {"delta_m": delta_od, "sd_m": float(np.std(finite, ddof=1)) if finite.size > 1 else None,
-                    "ci95_m": [lo, hi]}
-    range_block = _range_block(float(sides["a"]["ap_range_m"] - sides["b"]["ap_range_m"]), d_range, per_distance,
-                               confidence_level, too_small)
+        sd_od = float(np.std(finite, ddof=1)) if finite.size > 1 else None
+        if finite.size == n_resamples:  # the headline's place in the family, as the AP range's
+            lo, hi = delta_od - family.multiplier * sd_od, delta_od + family.multiplier * sd_od
+        else:  # an infinite tail: its percentile interval, widened as much
+            lo, hi = family.stretch(delta_od, *enclose(delta_od, *percentile_interval(d_od[~np.isnan(d_od)],
+                                                                                      confidence_level)))
+        od_block = {"delta_m": delta_od, "sd_m": sd_od, "ci95_m": [float(lo), float(hi)]}
+    range_block = _range_block(delta_range, family.interval(len(distances), delta_range), family.sd[-1], per_distance,
+                               too_small)
     out = {
         "format": COMPARE_FORMAT,
         "a": {"label": _label(a, b), "folder": str(a.folder), "camera": a.camera, "condition": a.condition,
@@ -327,6 +338,7 @@ def compare_runs(
         "seed": int(seed),
         "confidence_level": confidence_level,
         "paired": paired,
+        "family": {"members": len(distances) + 1, "sd_multiplier": family.multiplier},
         "found_rule": {"min_cars": MIN_FOUND_CARS, "min_fraction": MIN_FOUND_FRACTION, "score": FOUND_SCORE,
                        "iou": FOUND_IOU},
         "per_distance": per_distance,
@@ -337,17 +349,17 @@ def compare_runs(
     return out
 
 
-def _range_block(delta: float, resampled: np.ndarray, per_distance: list[dict], confidence_level: float,
+def _range_block(delta: float, interval: tuple[float, float], sd: float, per_distance: list[dict],
                  too_small: bool) -> dict:
-    """ΔAP range (m) with its SD and enclosing interval; ``resolved`` where the interval excludes 0
-    and the camera with the larger AP range found enough cars (:func:`cars_needed`) at a distance
-    where its AP is the higher: an area built from low-score boxes alone is not called."""
-    lo, hi = enclose(delta, *percentile_interval(resampled, confidence_level))
+    """ΔAP range (m) with its SD and interval (one of the family's); ``resolved`` where the
+    interval excludes 0 and the camera with the larger AP range found enough cars
+    (:func:`cars_needed`) at a distance where its AP is the higher: an area built from
+    low-score boxes alone is not called."""
+    lo, hi = interval
     side = "a" if delta > 0 else "b"
     sign = 1.0 if delta > 0 else -1.0
     backed = any(sign * r["delta_ap"] > 0 and r[f"found_{side}"] >= r["cars_needed"] for r in per_distance)
-    return {"delta_m": delta, "sd_m": float(np.std(resampled, ddof=1)) if resampled.size > 1 else None,
-            "ci95_m": [lo, hi], "resolved": bool((lo > 0 or hi < 0) and backed and not too_small)}
+    return {"delta_m": delta, "sd_m": float(sd), "ci95_m": [lo, hi], "resolved": bool((lo > 0 or hi < 0) and backed and not too_small)}
 
 
 def _finite(x: float) -> float | None:

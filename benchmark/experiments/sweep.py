@@ -120,7 +120,7 @@ def run_od50(run_dir: Path, *, n_resamples: int, seed: int) -> Od50Bootstrap:
     cache = run_dir / "od50.json"
     try:
         stored = read_od50_cache(cache)
-        if stored.key == key and stored.od50.ap_range_m is not None:  # (older caches lack the AP range: redone)
+        if stored.key == key and None not in (stored.od50.ap_range_m, stored.od50.interval_scale):  # (older: redone)
             return stored.od50
     except (OSError, ResultsFileError):
         pass  # none yet, or unreadable: computed again

@@ -21,6 +21,12 @@ method; BCa is not used because OD50 can be +inf for a resample). The AP range
 **Point inside its interval.** On few environments the full-sample value can fall outside
 the percentile interval of its resamples; every interval reported goes through
 :func:`enclose`: [min(lo, point), max(hi, point)] (docs/scoring.md).
+
+**Few environments.** A bootstrap over n environments underestimates a mean's variance by
+(n − 1)/n, and a normal quantile ignores that the spread is itself estimated from n values:
+both intervals are stretched about their points by
+:func:`~benchmark.scoring.simultaneous.few_environments_scale` (Student's
+t over the normal quantile, times √(n/(n − 1))). The SDs are the resamples' own.
 """
 
 from __future__ import annotations
@@ -37,6 +43,7 @@ from benchmark.record_base import Censored, JsonFloat, Record
 from benchmark.scoring.ap import ALL_AREAS, MAX_DETS, ap_by_distance, images_by_distance
 from benchmark.scoring.ap_range import ap_range
 from benchmark.scoring.od50 import od50, od50_censoring
+from benchmark.scoring.simultaneous import few_environments_scale, stretch
 
 REC_THRS = np.linspace(0.0, 1.00, 101)  # COCO recall thresholds
 IOU_THRS = np.linspace(0.5, 0.95, 10)
@@ -63,6 +70,7 @@ class Od50Bootstrap(Record):
     ap_range_m: float | None = None  # area under AP vs distance of the full set, m (benchmark.scoring.ap_range)
     ap_range_sd_m: float | None = None  # SD (ddof 1) of the resampled AP ranges, m
     ap_range_ci95_m: tuple[float, float] | None = None  # percentile interval of the AP range, m, enclosing the point
+    interval_scale: float | None = None  # both intervals stretched about their points by this (few environments)
 
 
 def resample_environments(groundtruth: dict, detections: list[dict], environments) -> tuple[dict, list[dict]]:
@@ -231,7 +239,8 @@ def bootstrap_od50(
     )
     dist, ranges = np.asarray(res.bootstrap_distribution, dtype=np.float64)
     finite = dist[np.isfinite(dist)]
-    lo, hi = enclose(point, *percentile_interval(dist, confidence_level))
+    scale = few_environments_scale(len(envs), confidence_level)
+    lo, hi = stretch(point, *enclose(point, *percentile_interval(dist, confidence_level)), scale)
     return Od50Bootstrap(
         od50_m=float(point),
         sd_m=float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
@@ -243,8 +252,10 @@ def bootstrap_od50(
         bound_m=bound_m,
         ap_range_m=float(range_point),
         ap_range_sd_m=float(np.std(ranges, ddof=1)),
-        ap_range_ci95_m=enclose(range_point, *percentile_interval(ranges, confidence_level)),
+        ap_range_ci95_m=stretch(range_point, *enclose(range_point, *percentile_interval(ranges, confidence_level)), scale),
+        interval_scale=scale,
     )
+
 
 
 def enclose(point: float, lo: float, hi: float) -> tuple[float, float]:

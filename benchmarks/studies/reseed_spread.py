@@ -53,13 +53,33 @@ def restricted(side: Side, environments: set) -> Side:
     return Side(side.folder, side.results, gt, [d for d in side.detections if d["image_id"] in ids])
 
 
-def called(result: dict) -> bool:
-    """Would compare call a difference here, by its intervals and found-car rule alone (the
-    minimum sample is switched off in :func:`main`: this measures what it has to stop)?"""
+def calls(result: dict) -> dict[str, bool]:
+    """What compare calls here, by its intervals and found-car rule alone (the minimum sample
+    is switched off in :func:`main`: this measures what it has to stop): the headline (ΔOD50,
+    or the ΔAP range where OD50 is censored), any distance, and either."""
     od = result["delta_od50"]
-    od_called = od["delta_m"] is not None and (od["ci95_m"][0] > 0 or od["ci95_m"][1] < 0)
-    range_called = bool(result.get("delta_ap_range") and result["delta_ap_range"]["resolved"])
-    return bool(od_called or range_called or any(r["resolved"] for r in result["per_distance"]))
+    if od["delta_m"] is not None:
+        headline = bool(od["ci95_m"][0] > 0 or od["ci95_m"][1] < 0)
+    else:
+        headline = bool(result.get("delta_ap_range") and result["delta_ap_range"]["resolved"])
+    distance = any(r["resolved"] for r in result["per_distance"])
+    return {"headline": headline, "distance": distance, "any": headline or distance}
+
+
+def called(result: dict) -> bool:
+    return calls(result)["any"]
+
+
+def od50_coverage(boots) -> dict:
+    """How often one run's OD50 95 % interval holds another reseed's OD50 (pairs of runs whose
+    OD50s are both measured), and the same for the AP range."""
+    held = {"od50": [], "ap_range": []}
+    for i, j in itertools.permutations(range(len(boots)), 2):
+        a, b = boots[i], boots[j]
+        if not a.censored and not b.censored:
+            held["od50"].append(a.ci95_m[0] <= b.od50_m <= a.ci95_m[1])
+        held["ap_range"].append(a.ap_range_ci95_m[0] <= b.ap_range_m <= a.ap_range_ci95_m[1])
+    return {k: {"pairs": len(v), "held": int(sum(v))} for k, v in held.items()}
 
 
 def main(argv=None) -> dict:
@@ -81,19 +101,20 @@ def main(argv=None) -> dict:
     pairs = list(itertools.combinations(range(len(sides)), 2))
     full = [compare_runs(sides[i], sides[j], n_resamples=args.resamples) for i, j in pairs]
     full_calls = [called(r) for r in full]
+    parts = {k: int(sum(calls(r)[k] for r in full)) for k in ("headline", "distance", "any")}
     deltas = np.array([r["delta_od50"]["delta_m"] for r in full if r["delta_od50"]["delta_m"] is not None])
     printed = np.array([r["delta_od50"]["sd_m"] for r in full if r["delta_od50"]["sd_m"] is not None])
     envs = sorted(sides[0].environments, key=str)
     rng = np.random.default_rng(0)
     by_k = {}
     for k in range(2, len(envs)):
-        calls = []
+        made = []
         for _ in range(args.subsets):
             i, j = pairs[rng.integers(len(pairs))]
             subset = set(rng.choice(np.array(envs, dtype=object), size=k, replace=False).tolist())
-            calls.append(called(compare_runs(restricted(sides[i], subset), restricted(sides[j], subset),
-                                             n_resamples=args.resamples)))
-        by_k[k] = {"draws": len(calls), "false_calls": int(sum(calls)), "rate": float(np.mean(calls))}
+            made.append(called(compare_runs(restricted(sides[i], subset), restricted(sides[j], subset),
+                                            n_resamples=args.resamples)))
+        by_k[k] = {"draws": len(made), "false_calls": int(sum(made)), "rate": float(np.mean(made))}
         print(f"k={k}: {by_k[k]}", file=sys.stderr, flush=True)
     by_k[len(envs)] = {"draws": len(pairs), "false_calls": int(sum(full_calls)), "rate": float(np.mean(full_calls))}
     summary = {
@@ -101,6 +122,11 @@ def main(argv=None) -> dict:
         "seeds": args.seeds, "environments": len(envs), "resamples": args.resamples,
         "od50_m": od50s.tolist(), "censored": [b.censored for b in boots],
         "od50_sd_across_seeds_m": float(np.std(finite, ddof=1)) if finite.size > 1 else None,
+        "ap_range_m": [b.ap_range_m for b in boots],
+        "ap_range_sd_across_seeds_m": float(np.std([b.ap_range_m for b in boots], ddof=1)),
+        "ap_range_bootstrap_sd_median_m": float(np.median([b.ap_range_sd_m for b in boots])),
+        "interval_holds_a_reseed": od50_coverage(boots),
+        "false_calls_all_environments": {**parts, "pairs": len(pairs)},
         "bootstrap_sd_m": {"median": float(np.nanmedian([b.sd_m for b in boots])),
                            "min": float(np.nanmin([b.sd_m for b in boots])),
                            "max": float(np.nanmax([b.sd_m for b in boots]))},
