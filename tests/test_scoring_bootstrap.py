@@ -93,3 +93,12 @@ def test_one_runs_intervals_are_the_percentile_ones_widened_for_few_environments
     assert widened.ap_range_ci95_m == pytest.approx(stretch(bare.ap_range_m, *bare.ap_range_ci95_m, scale))
     assert (widened.sd_m, widened.ap_range_sd_m) == (bare.sd_m, bare.ap_range_sd_m)
     assert widened.ci95_m[0] < bare.ci95_m[0] <= bare.od50_m <= bare.ci95_m[1] < widened.ci95_m[1]
+
+
+def test_on_two_environments_the_widened_interval_stops_at_0_m():
+    """× 9.2 on two environments: a distance's interval is cut at 0 m, not stretched below it."""
+    gt, dets = synthetic_collection(2, seed=5, half_range_m=60.0)
+    boot = bootstrap_od50(gt, dets, n_resamples=200)
+    assert boot.interval_scale > 9.0
+    assert boot.ci95_m[0] >= 0.0 and boot.ap_range_ci95_m[0] >= 0.0
+    assert 0.0 in (boot.ci95_m[0], boot.ap_range_ci95_m[0])

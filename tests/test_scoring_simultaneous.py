@@ -66,8 +66,12 @@ def test_a_member_that_never_moves_has_no_width_and_a_stretched_interval_keeps_a
     assert family.stretch(100.0, 100.0, 100.0) == (100.0, 100.0)
 
 
-def test_members_that_are_not_finite_are_refused():
-    with pytest.raises(ValueError, match="finite"):
-        family_intervals(np.array([0.0]), np.array([[0.0], [math.inf]]), 10)
+def test_a_members_resamples_that_are_not_finite_are_left_out_of_its_sd():
+    resampled = np.array([[0.0, 1.0, np.nan], [2.0, np.nan, np.nan], [4.0, 3.0, 1.0]])
+    family = family_intervals(np.array([2.0, 2.0, 1.0]), resampled, 10)
+    assert family.sd[0] == pytest.approx(2.0) and family.sd[1] == pytest.approx(np.std([1.0, 3.0], ddof=1))
+    assert np.isnan(family.sd[2]) and np.isnan(family.half_widths[2])
+    lo, hi = family.interval(2, 1.0)
+    assert not (lo > 0 or hi < 0)  # a NaN interval calls nothing
     with pytest.raises(ValueError, match=r"\(resamples, 2\)"):
         family_intervals(np.zeros(2), np.zeros((5, 3)), 10)

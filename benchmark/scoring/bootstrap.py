@@ -26,7 +26,8 @@ the percentile interval of its resamples; every interval reported goes through
 (n − 1)/n, and a normal quantile ignores that the spread is itself estimated from n values:
 both intervals are stretched about their points by
 :func:`~benchmark.scoring.simultaneous.few_environments_scale` (Student's
-t over the normal quantile, times √(n/(n − 1))). The SDs are the resamples' own.
+t over the normal quantile, times √(n/(n − 1))), no lower than 0 m (both are distances). The
+SDs are the resamples' own.
 """
 
 from __future__ import annotations
@@ -240,7 +241,7 @@ def bootstrap_od50(
     dist, ranges = np.asarray(res.bootstrap_distribution, dtype=np.float64)
     finite = dist[np.isfinite(dist)]
     scale = few_environments_scale(len(envs), confidence_level)
-    lo, hi = stretch(point, *enclose(point, *percentile_interval(dist, confidence_level)), scale)
+    lo, hi = stretch(point, *enclose(point, *percentile_interval(dist, confidence_level)), scale, floor=0.0)
     return Od50Bootstrap(
         od50_m=float(point),
         sd_m=float(np.std(finite, ddof=1)) if finite.size > 1 else float("nan"),
@@ -252,7 +253,8 @@ def bootstrap_od50(
         bound_m=bound_m,
         ap_range_m=float(range_point),
         ap_range_sd_m=float(np.std(ranges, ddof=1)),
-        ap_range_ci95_m=stretch(range_point, *enclose(range_point, *percentile_interval(ranges, confidence_level)), scale),
+        ap_range_ci95_m=stretch(range_point, *enclose(range_point, *percentile_interval(ranges, confidence_level)), scale,
+                                floor=0.0),
         interval_scale=scale,
     )
 

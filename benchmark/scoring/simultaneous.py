@@ -26,6 +26,9 @@ t 94–97 % (tests/test_scoring_simultaneous.py).
 where AP never falls to 0.5 in some resample (ΔOD50 infinite there) it keeps its percentile
 interval, stretched about its point by ``multiplier / z(1 − α/2)``
 (:meth:`FamilyIntervals.stretch`): an infinite end stays infinite.
+
+One run's OD50 and AP range (:func:`benchmark.scoring.bootstrap_od50`) are a family of one:
+their percentile intervals are stretched by :func:`few_environments_scale`.
 """
 
 from __future__ import annotations
@@ -56,18 +59,19 @@ def few_environments_scale(n_environments: int, confidence_level: float = 0.95) 
     return family_multiplier(n_environments, 1, confidence_level) / float(stats.norm.ppf(0.5 * (1.0 + confidence_level)))
 
 
-def stretch(point: float, lo: float, hi: float, scale: float) -> tuple[float, float]:
-    """[lo, hi], which holds ``point``, widened about it by ``scale`` (an infinite end stays
-    infinite; NaN stays NaN)."""
-    return float(point - (point - lo) * scale), float(point + (hi - point) * scale)
+def stretch(point: float, lo: float, hi: float, scale: float, floor: float = -math.inf) -> tuple[float, float]:
+    """[lo, hi], which holds ``point``, widened about it by ``scale``, its lower end no lower than
+    ``floor`` (a distance's 0; an infinite end stays infinite, NaN stays NaN)."""
+    low = point - (point - lo) * scale
+    return float(max(low, floor) if low == low else low), float(point + (hi - point) * scale)
 
 
 @dataclass(frozen=True)
 class FamilyIntervals:
     """Half-widths of a family's intervals (``point ± half_width``), held together at the level."""
 
-    half_widths: np.ndarray  # (members,) ≥ 0; 0 where a member's resamples do not vary
-    sd: np.ndarray  # (members,) bootstrap SD (ddof 1) of each member's resamples
+    half_widths: np.ndarray  # (members,) ≥ 0; 0 where a member's resamples do not vary, NaN without two finite
+    sd: np.ndarray  # (members,) bootstrap SD (ddof 1) of each member's finite resamples
     multiplier: float  # family_multiplier(n_environments, members, level)
     normal_quantile: float  # z(1 − α/2): what the multiplier replaces in a single normal interval
 
@@ -83,14 +87,18 @@ class FamilyIntervals:
 def family_intervals(points: np.ndarray, resampled: np.ndarray, n_environments: int,
                      confidence_level: float = 0.95) -> FamilyIntervals:
     """Intervals of ``points`` (members,) from their bootstrap ``resampled`` (resamples,
-    members) that hold together; every member must be finite in every resample (ValueError)."""
+    members) that hold together. A member's SD is over its finite resamples (an AP is NaN in a
+    resample without a counted car); with fewer than two its SD and half-width are NaN, and its
+    interval [NaN, NaN] excludes nothing."""
     points = np.asarray(points, dtype=np.float64)
     resampled = np.asarray(resampled, dtype=np.float64)
     if resampled.ndim != 2 or resampled.shape[1] != points.size:
         raise ValueError(f"resampled must be (resamples, {points.size}), got {resampled.shape}")
-    if len(resampled) < 2 or not (np.isfinite(resampled).all() and np.isfinite(points).all()):
-        raise ValueError("intervals that hold together need two or more resamples and finite members")
-    sd = np.std(resampled, axis=0, ddof=1)
+    sd = np.full(points.size, np.nan)
+    for j in range(points.size):
+        column = resampled[:, j][np.isfinite(resampled[:, j])]
+        if column.size > 1:
+            sd[j] = np.std(column, ddof=1)
     multiplier = family_multiplier(n_environments, points.size, confidence_level)
     return FamilyIntervals(half_widths=multiplier * sd, sd=sd, multiplier=multiplier,
                            normal_quantile=float(stats.norm.ppf(0.5 * (1.0 + confidence_level))))
