@@ -204,11 +204,11 @@ def test_a_new_submission_without_detections_is_refused(app, board, manifest, tm
 
 
 def test_a_reference_made_before_detections_shipped_is_accepted_with_its_warning(app, tmp_path):
-    path = COMMITTED / "submissions" / "ref-cam12-yolov5n-quick.json"
+    path = COMMITTED / "submissions" / "ref-cam12-yolov5n-metric-300.json"
     res, stderr = _invoke(app, ["submit", "--check", path])
     assert res.exit_code == 0, stderr
-    assert "ok: ref-cam12-yolov5n-quick.json (protocol quick, conditions day, dusk, night, night_regulation)" in res.output
-    assert ("warning: ref-cam12-yolov5n-quick.json was made before detections shipped (protocol 'quick', "
+    assert "ok: ref-cam12-yolov5n-metric-300.json (protocol metric-300, conditions day, dusk, night, night_regulation)" in res.output
+    assert ("warning: ref-cam12-yolov5n-metric-300.json was made before detections shipped (protocol 'metric-300', "
             "made_before_detections): its AP is accepted as published, not recomputed") in stderr
     with pytest.warns(NoDetectionsWarning):
         check_submission_file(path)
@@ -220,7 +220,7 @@ def test_a_reference_made_before_detections_shipped_is_accepted_with_its_warning
     edited.write_text(dumps_submission(sub))
     res, stderr = _invoke(app, ["submit", "--check", edited, "--leaderboard", tmp_path / "none"])
     assert res.exit_code == 2 and stderr.strip().splitlines() == [
-        "error: ref-cam12-yolov5n-quick.json: carries no detections: its AP cannot be recomputed (and it is not the file "
+        "error: ref-cam12-yolov5n-metric-300.json: carries no detections: its AP cannot be recomputed (and it is not the file "
         "pinned as made before detections shipped: edited?); `benchmark submit` writes them beside the file"], stderr
 
 
@@ -254,8 +254,8 @@ def test_compare_with_a_reference_from_the_cli_and_its_refusals(board, runs, tmp
     assert res.exit_code == 0, res.output
     assert "cam07 − ref-cam03" in " ".join(res.output.split())  # (4 environments: no verdict, the table all the same)
     for args, expected in (
-        ((mine, "--reference", "ref-cam12-yolov5n-quick", "--leaderboard", COMMITTED),
-         "error: ref-cam12-yolov5n-quick carries no detections (made before detections shipped): it cannot be paired by scene"),
+        ((mine, "--reference", "ref-cam12-yolov5n-metric-300", "--leaderboard", COMMITTED),
+         "error: ref-cam12-yolov5n-metric-300 carries no detections (made before detections shipped): it cannot be paired by scene"),
         ((runs / "runs" / "cam03-night", "--reference", "ref-cam07", "--leaderboard", board),
          "error: ref-cam07 has no condition 'night' (it has: day)"),
         ((mine, runs / "runs" / "cam03-day", "--reference", "ref-cam03", "--leaderboard", board),
