@@ -17,7 +17,7 @@ from metricscenes import numeric_pins
 from metricscenes.numeric_pins import isa_class, package_versions
 
 REPO = Path(__file__).resolve().parents[1]
-REFERENCE = REPO / "leaderboard" / "submissions" / "ref-cam12-yolov5n-quick.json"
+REFERENCE = REPO / "leaderboard" / "submissions" / "ref-cam12-yolov5n-metric-300.json"
 PROTOCOLS = REPO / "benchmark" / "leaderboard" / "data" / "protocols.yaml"
 
 
@@ -56,7 +56,7 @@ def test_a_reference_submission_is_checked_the_same_on_every_kind_of_machine(her
 def test_software_that_no_run_records_is_refused(tmp_path, versions, expected):
     """A run records every byte-deciding package's version (each is a dependency): none of these
     comes from one, and a package name is printed back at most 40 characters long."""
-    path = tmp_path / "ref-cam12-yolov5n-quick.json"
+    path = tmp_path / "ref-cam12-yolov5n-metric-300.json"
     path.write_text(json.dumps(_with_software(versions, isa_class())))
     res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(tmp_path / "lb")])
     assert res.exit_code == 2 and expected in res.output and len(res.output) < 400, res.output
@@ -66,7 +66,7 @@ def _pinned_leaderboard(folder: Path, sub: dict) -> Path:
     """A leaderboard whose protocols.yaml pins ``sub`` as made before detections shipped, as the
     committed references are, so that only the software check speaks."""
     protocols = yaml.safe_load(PROTOCOLS.read_text())
-    protocols["protocols"]["quick"]["made_before_detections"] = {sub["name"]: canonical_sha256(sub)}
+    protocols["protocols"]["metric-300"]["made_before_detections"] = {sub["name"]: canonical_sha256(sub)}
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "protocols.yaml").write_text(yaml.safe_dump(protocols, allow_unicode=True))
     return folder
@@ -77,15 +77,15 @@ def test_check_warns_about_other_versions_and_another_kernel_class(tmp_path):
     sub = _with_software({**package_versions(), "numpy": "1.0.0"}, other_isa)
     assert software_differences(sub) == [f"made with numpy 1.0.0 (here {package_versions()['numpy']})",
                                          f"made on an x86-64 {other_isa} machine (here {isa_class()})"]
-    path = tmp_path / "ref-cam12-yolov5n-quick.json"
+    path = tmp_path / "ref-cam12-yolov5n-metric-300.json"
     path.write_text(json.dumps(sub))
     lb = _pinned_leaderboard(tmp_path / "lb", sub)
     res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(lb)])
     assert res.exit_code == 0, res.output
-    assert "warning: ref-cam12-yolov5n-quick.json was made with numpy 1.0.0" in res.output
+    assert "warning: ref-cam12-yolov5n-metric-300.json was made with numpy 1.0.0" in res.output
     assert f"(here {package_versions()['numpy']}) and made on an x86-64 {other_isa} machine" in res.output
     sub["software"] = {"versions": package_versions(), "isa_class": other_isa}  # the machine alone: no "made with made on"
     path.write_text(json.dumps(sub))
     lb = _pinned_leaderboard(tmp_path / "lb2", sub)
     res = CliRunner().invoke(app, ["submit", "--check", str(path), "--leaderboard", str(lb)])
-    assert res.exit_code == 0 and f"quick.json was made on an x86-64 {other_isa} machine" in res.output, res.output
+    assert res.exit_code == 0 and f"metric-300.json was made on an x86-64 {other_isa} machine" in res.output, res.output
