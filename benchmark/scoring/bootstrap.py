@@ -259,7 +259,6 @@ def bootstrap_od50(
     )
 
 
-
 def enclose(point: float, lo: float, hi: float) -> tuple[float, float]:
     """[min(lo, point), max(hi, point)]: the interval reported, which always holds its point. On
     few environments the percentile interval can miss the full-sample value (its resamples
