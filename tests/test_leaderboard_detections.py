@@ -427,3 +427,32 @@ def test_save_submission_writes_detections_before_the_json(board, tmp_path):
     assert order == ["day.json.gz", "night.json.gz", "ref-cam03.json"]
     body = read_pack(pack_path(path, "day"), expected_sha256=sub["conditions"]["day"]["shipped_detections_sha256"])
     assert body["condition"] == "day"
+
+
+def test_the_quick_references_ship_their_detections_and_a_run_is_compared_with_them(tmp_path):
+    """quick's 13 references carry a checksummed pack per condition: `submit --check` recomputes
+    their AP from it, and a run on quick is paired with a reference scene by scene, nothing
+    rendered (here the run is cam05's, written from its reference's pack)."""
+    from test_compare import _write_run
+
+    from benchmark.cli.main import app as main_app
+    from benchmark.experiments.compare import load_reference
+
+    files = sorted((COMMITTED / "submissions").glob("ref-cam*-yolov5n-quick.json"))
+    assert len(files) == 13
+    for path in files:
+        conditions = json.loads(path.read_text())["conditions"]
+        assert all(c["shipped_detections_sha256"] for c in conditions.values()), path.name
+    res = CliRunner().invoke(main_app, ["submit", "--check", str(COMMITTED / "submissions" / "ref-cam12-yolov5n-quick.json"),
+                                        "--leaderboard", str(COMMITTED)])
+    assert res.exit_code == 0 and "AP recomputed from its shipped detections (4 condition(s))" in res.output, res.output
+    mine = load_reference("ref-cam05-yolov5n-quick", "day", COMMITTED)
+    run = tmp_path / "mine-day"
+    _write_run(run, "mine", "day", mine.groundtruth, mine.detections, mine.manifest_sha256)
+    res = CliRunner().invoke(main_app, ["compare", str(run), "--reference", "ref-cam12-yolov5n-quick",
+                                        "--leaderboard", str(COMMITTED), "--out", str(tmp_path / "c")])
+    assert res.exit_code == 0, res.output
+    result = json.loads((tmp_path / "c" / "compare.json").read_text())
+    assert result["n_environments"] == 10 and not result["sample_too_small"]
+    assert result["verdict"].startswith("daylight: ref-cam12-yolov5n-quick detects cars farther than mine"), result["verdict"]
+    assert (tmp_path / "c" / "compare.png").is_file()

@@ -29,7 +29,7 @@ from benchmark.leaderboard.detections import pack_path, pack_run, recompute, sha
 from benchmark.leaderboard.protocols import load_protocols
 from benchmark.leaderboard.schema import SUBMISSION_FORMAT, SubmissionError
 from benchmark.leaderboard.validate import (
-    MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, canonical_text, check_name, check_not_duplicate,
+    MAX_OD50_M, MAX_SUBMISSION_BYTES, SUBMISSIONS, camera_from_dump, canonical_text, check_name, check_not_duplicate,
     validate_submission, verify_detections,
 )
 from metricscenes.files import sha256_file, write_atomic
@@ -105,6 +105,13 @@ def _none_if_not_finite(x: float) -> float | None:
     return round(float(x), 3) if math.isfinite(x) else None
 
 
+def _none_if_beyond_reach(x: float) -> float | None:
+    """An OD50 spread or interval end as written: None (+inf) where it is infinite or beyond
+    :data:`~benchmark.leaderboard.validate.MAX_OD50_M` (resamples of a nearly flat AP curve
+    extrapolate to 1e16 m: no distance, and the validator's limit)."""
+    return None if not math.isfinite(x) or x > MAX_OD50_M else round(float(x), 3)
+
+
 def _detector_licence(detector: DetectorRecord) -> str:
     from benchmark.detectors import registry
 
@@ -177,8 +184,8 @@ def condition_entry(run: Run, *, n_resamples: int = N_RESAMPLES, seed: int = 0, 
             boot = bootstrap_od50(gt, dets, n_resamples=n_resamples, seed=seed, backend=res.scoring_backend)
     lo, hi = boot.ci95_m
     entry.update({
-        "od50_sd_m": _none_if_not_finite(boot.sd_m),
-        "od50_ci95_m": [_none_if_not_finite(lo), _none_if_not_finite(hi)],
+        "od50_sd_m": _none_if_beyond_reach(boot.sd_m),
+        "od50_ci95_m": [_none_if_beyond_reach(lo), _none_if_beyond_reach(hi)],
         "n_environments": len({im["environment_id"] for im in gt["images"]}),
     })  # fmt: skip
     return dict(sorted(entry.items()))
