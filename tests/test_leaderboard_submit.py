@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import warnings
 from pathlib import Path
 
 import jsonschema
@@ -308,9 +309,10 @@ def test_round_trip_on_the_smoke_collection(app, smoke_collection, tmp_path):
 
 def test_committed_reference_submissions_are_valid_and_rendered():
     """The reference submissions in leaderboard/ still pass every check against the
-    packaged protocols (a manifest change must come with new references; made before detections
-    shipped, each is accepted with its warning), and the committed table and band figures are
-    what `benchmark leaderboard` renders from them."""
+    packaged protocols (a manifest change must come with new references; metric-300's, made
+    before detections shipped, each with its warning; quick's recomputed from the detections
+    they ship, silently), and the committed table and band figures are what `benchmark
+    leaderboard` renders from them."""
     from benchmark.leaderboard import (
         NoDetectionsWarning, check_submission_file, load_protocols, load_submissions, render_html, render_markdown,
     )
@@ -320,8 +322,14 @@ def test_committed_reference_submissions_are_valid_and_rendered():
     subs = sorted((folder / "submissions").glob("*.json"))
     assert len(subs) >= 13
     for path in subs:
-        with pytest.warns(NoDetectionsWarning, match="made before detections shipped"):
-            data = check_submission_file(path)
+        if path.name.endswith("-metric-300.json"):
+            with pytest.warns(NoDetectionsWarning, match="made before detections shipped"):
+                data = check_submission_file(path)
+        else:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", NoDetectionsWarning)
+                data = check_submission_file(path)
+            assert all(c["shipped_detections_sha256"] for c in data["conditions"].values())
         assert data["collection"]["protocol"] in {"quick", "metric-300"}
     protocols = load_protocols(folder)
     submissions = load_submissions(folder, protocols)
@@ -338,3 +346,13 @@ def test_tree_hash_of_a_missing_folder_is_empty(tmp_path):
     (tmp_path / "a").mkdir()
     (tmp_path / "a" / "x.json").write_text("{}")
     assert list(tree_sha256(tmp_path)) == ["a/x.json"]
+
+
+def test_an_od50_spread_beyond_any_distance_is_written_as_infinite():
+    """A nearly flat AP curve's resamples extrapolate OD50 to 1e16 m (quick's cam13 by day): the
+    spread and interval ends beyond the validator's limit are written as null (+inf)."""
+    from benchmark.leaderboard.submission import _none_if_beyond_reach
+    from benchmark.leaderboard.validate import MAX_OD50_M
+
+    assert _none_if_beyond_reach(7.9e15) is None and _none_if_beyond_reach(math.inf) is None
+    assert _none_if_beyond_reach(MAX_OD50_M) == MAX_OD50_M and _none_if_beyond_reach(12.34567) == 12.346
