@@ -66,10 +66,6 @@ def calls(result: dict) -> dict[str, bool]:
     return {"headline": headline, "distance": distance, "any": headline or distance}
 
 
-def called(result: dict) -> bool:
-    return calls(result)["any"]
-
-
 def od50_coverage(boots) -> dict:
     """How often one run's OD50 95 % interval holds another reseed's OD50 (pairs of runs whose
     OD50s are both measured), and the same for the AP range."""
@@ -100,8 +96,8 @@ def main(argv=None) -> dict:
     finite = od50s[np.isfinite(od50s)]
     pairs = list(itertools.combinations(range(len(sides)), 2))
     full = [compare_runs(sides[i], sides[j], n_resamples=args.resamples) for i, j in pairs]
-    full_calls = [called(r) for r in full]
-    parts = {k: int(sum(calls(r)[k] for r in full)) for k in ("headline", "distance", "any")}
+    full_calls = [calls(r) for r in full]
+    parts = {k: int(sum(c[k] for c in full_calls)) for k in ("headline", "distance", "any")}
     deltas = np.array([r["delta_od50"]["delta_m"] for r in full if r["delta_od50"]["delta_m"] is not None])
     printed = np.array([r["delta_od50"]["sd_m"] for r in full if r["delta_od50"]["sd_m"] is not None])
     envs = sorted(sides[0].environments, key=str)
@@ -112,11 +108,11 @@ def main(argv=None) -> dict:
         for _ in range(args.subsets):
             i, j = pairs[rng.integers(len(pairs))]
             subset = set(rng.choice(np.array(envs, dtype=object), size=k, replace=False).tolist())
-            made.append(called(compare_runs(restricted(sides[i], subset), restricted(sides[j], subset),
-                                            n_resamples=args.resamples)))
+            made.append(calls(compare_runs(restricted(sides[i], subset), restricted(sides[j], subset),
+                                           n_resamples=args.resamples))["any"])
         by_k[k] = {"draws": len(made), "false_calls": int(sum(made)), "rate": float(np.mean(made))}
         print(f"k={k}: {by_k[k]}", file=sys.stderr, flush=True)
-    by_k[len(envs)] = {"draws": len(pairs), "false_calls": int(sum(full_calls)), "rate": float(np.mean(full_calls))}
+    by_k[len(envs)] = {"draws": len(pairs), "false_calls": parts["any"], "rate": parts["any"] / len(pairs)}
     summary = {
         "collection": str(args.collection), "camera": args.camera, "condition": args.condition,
         "seeds": args.seeds, "environments": len(envs), "resamples": args.resamples,
