@@ -298,7 +298,7 @@ def compare_runs(
         needed = cars_needed(n_cars)
         backed = (found_a if delta > 0 else found_b) >= needed  # the higher AP rests on found cars
         per_distance.append({"distance_m": float(dm), "ap_a": float(sides["a"]["ap"][j]), "ap_b": float(sides["b"]["ap"][j]),
-                             "delta_ap": delta, "sd": float(family.sd[j]),
+                             "delta_ap": delta, "sd": _finite(family.sd[j]),
                              "ci95": [lo, hi], "n_cars": n_cars, "found_a": found_a, "found_b": found_b,
                              "cars_needed": needed, "blind_below": blind_below(n_cars),
                              "resolved": bool((lo > 0 or hi < 0) and backed and not too_small),
@@ -359,7 +359,7 @@ def _range_block(delta: float, interval: tuple[float, float], sd: float, per_dis
     side = "a" if delta > 0 else "b"
     sign = 1.0 if delta > 0 else -1.0
     backed = any(sign * r["delta_ap"] > 0 and r[f"found_{side}"] >= r["cars_needed"] for r in per_distance)
-    return {"delta_m": delta, "sd_m": float(sd), "ci95_m": [lo, hi], "resolved": bool((lo > 0 or hi < 0) and backed and not too_small)}
+    return {"delta_m": delta, "sd_m": _finite(sd), "ci95_m": [lo, hi], "resolved": bool((lo > 0 or hi < 0) and backed and not too_small)}
 
 
 def _finite(x: float) -> float | None:
