@@ -23,7 +23,7 @@ import sys
 from pathlib import Path
 
 from metricscenes.generate import generate, plan_units
-from metricscenes.manifest import parse_manifest
+from metricscenes.manifest import WIDE_KINDS, parse_manifest
 from metricscenes.plan import plan_collection
 from metricscenes.store import PROGRESS_DIR, RADIANCE_STORE
 from metricscenes.writer import VARIANT_STAMP
@@ -76,7 +76,7 @@ def main(argv=None) -> int:
         (args.out / meta.relative_to(args.source)).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(meta, args.out / meta.relative_to(args.source))
     for u in units:
-        for kind in ("plates", "insets", "frames", "masks"):
+        for kind in ("plates", "insets", "frames", "masks", *WIDE_KINDS):
             if (store / kind / u.key).is_dir():
                 link_tree(store / kind / u.key, args.out / RADIANCE_STORE / kind / u.key)
         shutil.copyfile(args.source / PROGRESS_DIR / f"{u.key}.json", args.out / PROGRESS_DIR / f"{u.key}.json")

@@ -31,7 +31,7 @@ import numpy as np
 from metricscenes.backends import check_scheduler, is_remote, map_units, threads_per_unit
 from metricscenes.geometry import TanExtent
 from metricscenes.groundtruth import box_iou, box_tan_to_xywh, car_box_tan, mask_box_tan
-from metricscenes.manifest import PLATE_LIGHT_GROUPS, Manifest, ManifestError
+from metricscenes.manifest import PLATE_LIGHT_GROUPS, WIDE_KINDS, Manifest, ManifestError
 from metricscenes.plan import EnvironmentPlan, ScenePlan, plan_collection
 from metricscenes.records import PLATE, InsetTruth, RecordError, UnitRecord
 from metricscenes.store import PROGRESS_DIR, RADIANCE_STORE, CollectionError, read_checked
@@ -172,12 +172,17 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
     ref_w, ref_h = manifest.reference_grid.width_px, manifest.reference_grid.height_px
     field = manifest.reference_grid.field
     env = unit.environment
-    parts = scene_mod.environment_parts(env, ground_to_horizon=bool(manifest.render.ground_to_horizon))
+    parts = scene_mod.environment_parts(env, ground_to_horizon=bool(manifest.render.ground_to_horizon),
+                                        road_end_m=manifest.render.road_end_m)
     inset = None if held is None else held.inset
     started = time.perf_counter()
     if unit.kind == PLATE:
         groups = [g for g in manifest.light_groups if g in PLATE_LIGHT_GROUPS]
         jobs = [("plates", g, Film(ref_w, ref_h, field=field), manifest.render.plate_spp, field) for g in groups]
+        wide = manifest.wide_plate
+        if wide is not None:  # after the plates' jobs: theirs keep their indices, and so their seeds
+            jobs += [("wide_plates", g, Film(wide.width_px, wide.height_px, field=wide.field), wide.spp, wide.field)
+                     for g in groups]
     else:
         env_parts = parts
         pose = scene_mod.car_pose(env, unit.distance_m)
@@ -197,6 +202,10 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
             # reach the camera): that group also gets a whole frame at plate sampling, or coarser.
             jobs.append(("frames", "car_lights", Film(*manifest.frame_grid_px(), field=field),
                          manifest.render.plate_spp, field))
+            wide = manifest.wide_plate
+            if wide is not None:  # (and beyond the reference field, for the wide plate's cameras)
+                jobs.append(("wide_frames", "car_lights", Film(*manifest.wide_frame_grid_px(), field=wide.field),
+                             wide.spp, wide.field))
     illuminance = {}
     # Every job keeps its index among all of the unit's jobs, and so its seed, whichever are rendered now.
     lit = [(i, job) for i, job in enumerate(jobs) if scene_mod.has_emitters(parts, job[1])]
@@ -209,7 +218,7 @@ def render_unit(manifest_json: dict, unit: Unit, out_dir: str, threads: int | No
                              max_depth=manifest.render.max_depth)
         for group in groups:
             arrays.write_radiance(kind, group, images[group], extent, {"spp": spp, "seed": unit.seed})
-        if unit.kind != PLATE:
+        if kind != "plates":  # the illuminance at the camera is the plate's, metered once
             continue
         if one_pass:  # the pass's groups in one trace, with a kernel shared by every plate
             irradiance = meter_pass(env, parts, groups, seed=unit.seed + 7919 * seeds[0],
@@ -381,6 +390,8 @@ def _expected_attributes(manifest: Manifest, unit: Unit, path: str, stored: dict
         extent = manifest.reference_grid.field
     store = manifest.store
     spp = manifest.render.inset_spp if kind == "insets" else manifest.render.plate_spp
+    if kind in WIDE_KINDS:
+        extent, spp = manifest.wide_plate.field, manifest.wide_plate.spp
     basis = stored.get("spectral_basis") if store and store.spectral_basis else None
     return radiance_attributes(path.split("/")[-1], extent, store.mantissa_bits if store else None, basis,
                                {"spp": spp, "seed": unit.seed})
@@ -501,7 +512,13 @@ def _checked_root_and_variant(manifest: Manifest, out_dir: str | Path, workers: 
     cluster, resolving it is a round trip to one of its workers)."""
     from metricscenes.manifest import check_memory
 
+    from metricscenes.scene_checks import farthest_scene_problems
+
     root = check_out_dir(out_dir)
+    problems = farthest_scene_problems(manifest)
+    if problems:
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise ManifestError(f"manifest {manifest.name}: {problems[0]}{more}")
     check_scheduler(scheduler)
     if not is_remote(scheduler):  # a running cluster's workers have their own machines' memory
         check_memory(manifest, workers, source=f"manifest {manifest.name}")

@@ -32,6 +32,9 @@ PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights", "ego_
 
 
 MAX_WEIGHT = 1e6
+# Road a car needs ahead of the camera beyond its distance: its own length (at most 5.5 m in the
+# library) and road seen behind it, so that no car stands at the detailed road's end.
+CAR_CLEARANCE_M = 20.0
 """Largest light-group weight of a condition (a weight of 1e300 would overflow float32 radiance)."""
 MAX_MANIFEST_BYTES = 1 << 20
 CONDITION_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
@@ -106,6 +109,43 @@ class ReferenceGrid(_Strict):
         return field_extent(self.hfov_deg, self.width_px, self.height_px)
 
 
+WIDE_KINDS = ("wide_plates", "wide_frames")
+"""The store's arrays of a manifest's ``wide_plate``: its plates (``wide_plates/<env>/<group>``)
+and the car lamps' frames on its grid (``wide_frames/<scene>/car_lights``)."""
+
+
+class WidePlate(_Strict):
+    """A second, coarser plate around the reference grid's field, for cameras wider than it
+    (docs/scenes.md, "The wide plate"): ``hfov_deg`` horizontally, the vertical field from the
+    grid's aspect, rendered once per environment and light group at ``spp`` samples per pixel.
+    A camera inside the reference field never reads it; a wider one sees the reference plate
+    (and the car's inset) composited over it at its own sampling."""
+
+    width_px: Int = Field(ge=16, le=8192)
+    height_px: Int = Field(ge=9, le=8192)
+    hfov_deg: Float = Field(ge=5.0, le=150.0, description="horizontal field of view, degrees")
+    spp: Int = Field(ge=1, le=65536, description="samples per pixel")
+
+    @field_validator("spp")
+    @classmethod
+    def _square(cls, value: int) -> int:
+        return RenderSettings._square(value)
+
+    @model_validator(mode="after")
+    def _aspect(self) -> "WidePlate":
+        aspect = self.width_px / self.height_px
+        if not 1.0 <= aspect <= 4.0:
+            raise ValueError(f"wide_plate aspect {aspect:.3g} must lie between 1 and 4")
+        return self
+
+    @property
+    def field(self):
+        """The field the wide plate covers, in tangent coordinates."""
+        from metricscenes.geometry import field_extent
+
+        return field_extent(self.hfov_deg, self.width_px, self.height_px)
+
+
 AUTO_VARIANT = "auto"
 """``render.variant`` that lets the machine choose (:func:`metricscenes.render.resolve_variant`)."""
 
@@ -142,6 +182,10 @@ class RenderSettings(_Strict):
         "rendered sky that has one above the horizon (the plate has no car, so a shadow outside the window is "
         "lost; unset: the car's box and margins only); see metricscenes.generate.inset_window and docs/scenes.md, "
         "'The car's shadow'")
+    road_end_m: Float | None = Field(
+        None, ge=100.0, le=5000.0, description="where the detailed road ends ahead of the camera, metres: its "
+        "paving, markings, terrain tiles, trees and street lights (unset: 395 m); beyond it the plain far road and "
+        "ground; see metricscenes.assets.roads.road_parts. Every distance must leave the car on it (Manifest)")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else llvm_ad_spectral where a libLLVM >= 17
     # renders, else scalar_spectral (metricscenes.render.resolve_variant; the variant used is recorded in
     # manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
@@ -367,6 +411,7 @@ class Manifest(_Strict):
     conditions: dict[str, dict[str, Float] | TargetedCondition] = Field(min_length=1)
     illuminance_sweep: IlluminanceSweep | None = None
     store: StoreSettings | None = None
+    wide_plate: WidePlate | None = None
     read_time_conditions: dict[str, dict[str, Float] | TargetedCondition] | None = None
     """Conditions outside the manifest's identity: mixed at read time from the stored groups
     like every condition, but left out of its sha256, so that adding one changes no hash that
@@ -452,11 +497,32 @@ class Manifest(_Strict):
             raise ValueError(f"{where}: lights nothing (give at least one light group a weight > 0)")
 
     @model_validator(mode="after")
+    def _scene_holds(self) -> "Manifest":
+        from metricscenes.assets.roads import ROAD_X_RANGE_M
+        from metricscenes.geometry import extent_within
+
+        road_end = self.render.road_end_m or ROAD_X_RANGE_M[1]
+        farthest = max(self.distances_m)
+        if farthest + CAR_CLEARANCE_M > road_end:
+            raise ValueError(f"distances_m: a car at {farthest:g} m stands beyond the detailed road, which ends at "
+                             f"{road_end:g} m (it needs {CAR_CLEARANCE_M:g} m more): set render.road_end_m to at "
+                             f"least {farthest + CAR_CLEARANCE_M:g}")
+        wide, grid = self.wide_plate, self.reference_grid
+        if wide is not None and not (extent_within(grid.field, wide.field) and wide.field != grid.field):
+            from metricscenes.geometry import fov_deg
+
+            (gh, gv), (wh, wv) = fov_deg(grid.field), fov_deg(wide.field)
+            raise ValueError(f"wide_plate: its field {wh:.2f}° x {wv:.2f}° must hold the reference grid's "
+                             f"{gh:.2f}° x {gv:.2f}° and be wider")
+        return self
+
+    @model_validator(mode="after")
     def _frame_grid(self) -> "Manifest":
-        divisor, grid = self.render.frame_divisor, self.reference_grid
-        if divisor is not None and (grid.width_px % divisor or grid.height_px % divisor):
-            raise ValueError(f"render.frame_divisor: {divisor} must divide the reference grid "
-                             f"({grid.width_px} x {grid.height_px} px)")
+        divisor = self.render.frame_divisor
+        for name, grid in (("reference grid", self.reference_grid), ("wide plate", self.wide_plate)):
+            if divisor is not None and grid is not None and (grid.width_px % divisor or grid.height_px % divisor):
+                raise ValueError(f"render.frame_divisor: {divisor} must divide the {name} "
+                                 f"({grid.width_px} x {grid.height_px} px)")
         return self
 
     @property
@@ -501,6 +567,12 @@ class Manifest(_Strict):
         divisor = self.render.frame_divisor or 1
         return self.reference_grid.width_px // divisor, self.reference_grid.height_px // divisor
 
+    def wide_frame_grid_px(self) -> tuple[int, int]:
+        """(width, height) of the car lamps' frame on the wide plate's field: its grid, or it
+        divided by ``render.frame_divisor``."""
+        divisor = self.render.frame_divisor or 1
+        return self.wide_plate.width_px // divisor, self.wide_plate.height_px // divisor
+
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
         return manifest_sha256(self.model_dump(mode="json"))
@@ -515,7 +587,8 @@ class Manifest(_Strict):
         w, h = self.reference_grid.width_px, self.reference_grid.height_px
         k_fine = math.ceil(1e3 * self.reference_grid.field.width / w / self.render.inset_pixel_mrad)
         inset = min((self.render.inset_max_px + 2) ** 2, w * h * k_fine**2)
-        return max(w * h, inset)
+        wide = 0 if self.wide_plate is None else self.wide_plate.width_px * self.wide_plate.height_px
+        return max(w * h, inset, wide)
 
     def memory_estimate_bytes(self) -> int:
         """Upper estimate of one render process's peak memory (see PROCESS_BASE_BYTES), with
@@ -524,7 +597,7 @@ class Manifest(_Strict):
         films = PROCESS_BASE_BYTES + BYTES_PER_FILM_PIXEL * self.largest_film_px()
         if self.render.variant == "scalar_spectral":
             return films
-        spp = max(self.render.plate_spp, self.render.inset_spp)
+        spp = max(self.render.plate_spp, self.render.inset_spp, self.wide_plate.spp if self.wide_plate else 1)
         return films + BYTES_PER_WAVEFRONT_LANE * min(self.largest_film_px() * spp, MAX_WAVEFRONT_LANES)
 
 
@@ -575,7 +648,7 @@ def canonical_sha256(data) -> str:
 # Fields added after collections were first published (paths into the manifest's JSON
 # form), omitted from the hash while unset so that every earlier manifest keeps its
 # sha256 (pinned by protocols and collections).
-HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("render", "inset_feather"),
+HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("wide_plate",), ("render", "road_end_m"), ("render", "inset_feather"),
                         ("render", "ground_to_horizon"), ("render", "frame_divisor"), ("store", "mantissa_bits"),
                         ("store", "spectral_basis"), ("render", "plate_lamp"), ("render", "rear_retroreflectors"),
                         ("render", "inset_shadow"))

@@ -19,12 +19,12 @@ plate's grid first, then interpolated as the plate is (docs/scenes.md, "The inse
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
 
-from metricscenes.geometry import REFERENCE_EXTENT, TanExtent
+from metricscenes.geometry import REFERENCE_EXTENT, TanExtent, extent_within
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
 
 
@@ -63,12 +63,17 @@ class SpectralScene:
 
     Attributes:
         layers: plate first, then insets (pasted in order).
+        surround: a coarser plate over a wider field than the plate's (a collection's
+            ``wide_plate``), or None. Read only by a grid that reaches beyond the plate: the
+            plate is then pasted over it with a feather of :data:`PLATE_SEAM_FEATHER`, then
+            the insets as ever; a grid inside the plate's field never reads it.
         wavelengths_nm: band centres, nm.
         units: radiance units (always ``W sr-1 m-2 nm-1``).
         metadata: free-form facts (scene id, condition, distance_m, ...).
     """
 
     layers: tuple[RadianceLayer, ...]
+    surround: RadianceLayer | None = None
     wavelengths_nm: np.ndarray = field(default_factory=lambda: WAVELENGTHS_NM.copy())
     units: str = RADIANCE_UNITS
     metadata: dict = field(default_factory=dict)
@@ -86,7 +91,13 @@ class SpectralScene:
 
     @property
     def extent(self) -> TanExtent:
+        """The plate's field (what the ground truth's grid and the photometric targets cover)."""
         return self.layers[0].extent
+
+    @property
+    def widest_extent(self) -> TanExtent:
+        """The widest field a camera may see: the surround's where there is one, else the plate's."""
+        return self.extent if self.surround is None else self.surround.extent
 
     @classmethod
     def uniform(
@@ -117,7 +128,16 @@ class SpectralScene:
         if key in self._last_resample:
             return self._last_resample[key]
         plate = self.layers[0]
-        out = _apply(*_weights(plate, cols, rows, extent), self._once(("plate",), lambda: band_planes(plate.radiance)))
+        if self.surround is not None and not extent_within(extent, plate.extent):
+            surround = self.surround
+            out = _apply(*_weights(surround, cols, rows, extent),
+                         self._once(("surround",), lambda: band_planes(surround.radiance)))
+            # (one feathered plate per scene: the once-cache keys it by its id)
+            seam_plate = self._once(("seam plate",), lambda: replace(plate, feather=PLATE_SEAM_FEATHER))
+            _paste(out, seam_plate, cols, rows, extent, surround.extent, once=self._once)
+        else:
+            out = _apply(*_weights(plate, cols, rows, extent),
+                         self._once(("plate",), lambda: band_planes(plate.radiance)))
         finer = (extent.width / cols < plate.pixel_tan[0] * (1 - 1e-9)
                  and extent.height / rows < plate.pixel_tan[1] * (1 - 1e-9))
         for inset in self.layers[1:]:
@@ -128,6 +148,12 @@ class SpectralScene:
         self._last_resample.clear()  # one grid kept: a sweep takes its cameras grid by grid
         self._last_resample[key] = out.transpose(1, 2, 0)
         return self._last_resample[key]
+
+
+# The share of the plate's width (height) over which, along each edge, it blends into the surround:
+# both estimate the same radiance without bias, so the ramp turns the step between their samplings
+# and noise levels into a gradual one (as an inset's feather does; docs/scenes.md, "The wide plate").
+PLATE_SEAM_FEATHER = 0.05
 
 
 def on_grid_of(layer: RadianceLayer, target: RadianceLayer) -> np.ndarray:

@@ -48,10 +48,13 @@ def car_pose(env: EnvironmentPlan, distance_m: float) -> CarPose:
     )
 
 
-def environment_parts(env: EnvironmentPlan, ground_to_horizon: bool = False) -> SceneParts:
+def environment_parts(env: EnvironmentPlan, ground_to_horizon: bool = False,
+                      road_end_m: float | None = None) -> SceneParts:
     """The road, its trees and street lights, and the camera vehicle's own head lamps
-    (``ground_to_horizon``: see :func:`metricscenes.assets.roads.horizon_edge`)."""
-    road = roads.road_parts(roads.road_spec(env.road_id), seed=env.seed, ground_to_horizon=ground_to_horizon)
+    (``ground_to_horizon``: see :func:`metricscenes.assets.roads.horizon_edge`; ``road_end_m``:
+    where the detailed road ends, :func:`metricscenes.assets.roads.road_parts`)."""
+    road = roads.road_parts(roads.road_spec(env.road_id), seed=env.seed, ground_to_horizon=ground_to_horizon,
+                            road_end_m=road_end_m)
     return road.merged(ego_vehicle.ego_lamp_parts())
 
 

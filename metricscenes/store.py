@@ -11,6 +11,8 @@ Layout of a collection folder::
                                         (the plates' grid, or render.frame_divisor times coarser: read
                                         onto the plate's grid, radiance.on_grid_of)
       masks/<scene>                     (y, x) bool, the car's visible pixels over the inset window
+      wide_plates/<env>/<light_group>   with a manifest's wide_plate: a coarser plate over a wider field
+      wide_frames/<scene>/car_lights    and the car's lamps on its grid (read by wider cameras only)
     groundtruth.json                    COCO, one car box per scene (reference grid)
     manifest.resolved.yaml              manifest as run, package version, the Mitsuba variant that
                                         rendered it, the light groups it holds where fewer than the
@@ -120,7 +122,7 @@ class Collection:
         for ann in groundtruth["annotations"]:
             self._boxes.setdefault(ann["image_id"], []).append(ann["bbox"])
         self._zarr = None
-        self._plate_mix: tuple[tuple, RadianceLayer] | None = None  # the last plate mixed, and its key
+        self._plate_mix: dict[str, tuple[tuple, RadianceLayer]] = {}  # per kind of plate, the last mixed and its key
         # The light groups of each plate, inset and frame, as recorded (sorted: float sums
         # are not associative); a recorded array that is absent is an error, not a zero.
         self._recorded: dict[str, list[str]] = {}
@@ -187,6 +189,13 @@ class Collection:
         """The field of view the plates and the ground-truth grid cover (tangent extent;
         the reference field unless the manifest set ``reference_grid.hfov_deg``)."""
         return self.manifest.reference_grid.field
+
+    @property
+    def widest_field(self) -> TanExtent | None:
+        """The wide plate's field (``wide_plate``: what a camera wider than :attr:`field` may
+        see), or None for a collection without one."""
+        wide = self.manifest.wide_plate
+        return None if wide is None else wide.field
 
     def scenes(self) -> list[SceneRecord]:
         return [
@@ -476,11 +485,11 @@ class Collection:
         if not lit and not required:  # a frame whose lamps are off adds nothing
             return None
         key = None
-        if kind == "plates":  # one plate serves its environment's scenes, read in turn: mixed once
+        if kind in ("plates", "wide_plates"):  # one plate serves its environment's scenes, read in turn: mixed once
             key = (unit, tuple((g, weights[g]) for g in lit),
                    tuple(_fingerprint(self.root, f"{kind}/{unit}/{g}") for g in lit))  # a changed file is read again
-            if self._plate_mix is not None and self._plate_mix[0] == key:
-                return self._plate_mix[1]
+            if kind in self._plate_mix and self._plate_mix[kind][0] == key:
+                return self._plate_mix[kind][1]
         total, extent = None, None
         for light_group in lit:
             w = weights[light_group]
@@ -497,7 +506,7 @@ class Collection:
         layer = RadianceLayer(total, extent)
         if key is not None:
             total.flags.writeable = False  # shared by the scenes that reuse it
-            self._plate_mix = (key, layer)
+            self._plate_mix[kind] = (key, layer)
         return layer
 
     def _node(self, path: str, scene_id: str):
@@ -552,8 +561,15 @@ class Collection:
         if inset_resolution == "car" and mask.shape == inset.radiance.shape[:2]:
             inset = replace(inset, sharp=car_sharpness(mask, inset.extent, plate.pixel_tan))
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
+        surround = None
+        if self.manifest.wide_plate is not None:  # the wide plate, with the car lamps' light on its grid
+            env_unit = f"env{img['environment_id']:03d}"
+            surround = self._mix("wide_plates", env_unit, weights, scene_id)
+            wide_frame = self._mix("wide_frames", scene_id, weights, scene_id, required=False)
+            if wide_frame is not None:
+                surround = RadianceLayer(surround.radiance + on_grid_of(wide_frame, surround), surround.extent)
         return SpectralScene(
-            layers=layers,
+            layers=layers, surround=surround,
             metadata={"scene_id": scene_id, "condition": condition, "distance_m": img["distance_m"],
                       "environment_id": img["environment_id"]},
         )

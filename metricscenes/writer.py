@@ -39,7 +39,7 @@ import numpy as np
 
 from metricscenes.files import write_atomic
 from metricscenes.geometry import TanExtent
-from metricscenes.manifest import AUTO_VARIANT, Manifest
+from metricscenes.manifest import AUTO_VARIANT, WIDE_KINDS, Manifest
 from metricscenes.plan import ScenePlan
 from metricscenes.records import PLATE, ResolvedManifest, UnitRecord, resolved_content_sha256
 from metricscenes.spectral import RADIANCE_UNITS, WAVELENGTHS_NM
@@ -259,7 +259,7 @@ class CollectionWriter:
         zroot = zarr.open_group(str(self.root / RADIANCE_STORE), mode="a")
         zroot.attrs.update({"units": "W sr-1 m-2 nm-1", "manifest_sha256": manifest.sha256(),
                             "dimension_names": ["y", "x", "wavelength"]})
-        for name in ("plates", "insets", "frames", "masks"):
+        for name in ("plates", "insets", "frames", "masks", *(WIDE_KINDS if manifest.wide_plate else ())):
             zroot.require_group(name)
 
     def _has_finished_work(self) -> bool:

@@ -100,26 +100,33 @@ def sensor_extent(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> Ta
     return centred_extent(camera.tan_half_width, camera.tan_half_height, field)
 
 
-def camera_window(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT) -> TanExtent:
+def camera_window(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT, widest: TanExtent | None = None) -> TanExtent:
     """The window of ``field`` (a collection's, or a scene's plate extent) that ``camera``
     samples: :func:`camera_extent`, refused (:class:`FieldOfViewError`) where it exceeds
-    ``field`` in either axis. The registry cameras get ``field`` itself."""
+    ``field`` in either axis, unless it lies inside ``widest`` (a collection's wide plate's
+    field; None: none). The registry cameras get ``field`` itself."""
     window = camera_extent(camera, field)
-    if not extent_within(window, field):
-        h, v = camera.hfov_deg, camera.vfov_deg
-        fh, fv = fov_deg(field)
-        raise FieldOfViewError(
-            f"camera {camera.name!r} sees {h:.2f}° x {v:.2f}° (focal length {camera.optics.focal_length_mm:g} mm, "
-            f"pixel array {camera.sensor.array_width_mm:.4g} x {camera.sensor.array_height_mm:.4g} mm), more than "
-            f"the collection's field {fh:.2f}° x {fv:.2f}°: use a longer focal length or a smaller active area")
-    return window
+    if extent_within(window, field):
+        return window
+    if widest is not None:
+        window = camera_extent(camera, widest)
+        if extent_within(window, widest):
+            return window
+    h, v = camera.hfov_deg, camera.vfov_deg
+    fh, fv = fov_deg(field if widest is None else widest)
+    raise FieldOfViewError(
+        f"camera {camera.name!r} sees {h:.2f}° x {v:.2f}° (focal length {camera.optics.focal_length_mm:g} mm, "
+        f"pixel array {camera.sensor.array_width_mm:.4g} x {camera.sensor.array_height_mm:.4g} mm), more than "
+        f"the collection's {'widest ' if widest is not None else ''}field {fh:.2f}° x {fv:.2f}°: use a longer "
+        "focal length or a smaller active area")
 
 
-def lens_mapping(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT):
+def lens_mapping(camera: CameraSpec, field: TanExtent = REFERENCE_EXTENT, widest: TanExtent | None = None):
     """What the camera's ground truth follows: (the extent its pixel grid spans, the
     lens's map from scene to sensor tangent coordinates or None for an ideal lens), as
-    :func:`metricscenes.groundtruth.scale_groundtruth` takes them (``window``, ``to_sensor``)."""
-    camera_window(camera, field)  # refused if it sees more than the field
+    :func:`metricscenes.groundtruth.scale_groundtruth` takes them (``window``, ``to_sensor``).
+    ``field`` is the ground truth's; ``widest`` as :func:`camera_window`'s."""
+    camera_window(camera, field, widest)  # refused if it sees more than the field
     k = camera.optics.distortion
     return sensor_extent(camera, field), (None if k is None else lambda xy: _distortion.distort(xy, *k))
 
@@ -154,7 +161,7 @@ def sensor_radiance(scene: SpectralScene, camera: CameraSpec, *, shape_px: tuple
     distortion where it has one; refused (ValueError) where it is not finite."""
     rows, cols = shape_px or (camera.height_px, camera.width_px)
     if extent is None:
-        camera_window(camera, scene.extent)  # refuses a camera that sees more than the scene
+        camera_window(camera, scene.extent, None if scene.surround is None else scene.widest_extent)  # or refuses it
         extent = sensor_extent(camera, scene.extent)
     if camera.optics.distortion is None:
         radiance = scene.resample(cols, rows, extent)

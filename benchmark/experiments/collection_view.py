@@ -19,6 +19,12 @@ def collection_field(collection):
     return getattr(collection, "field", REFERENCE_EXTENT)
 
 
+def collection_widest_field(collection):
+    """The widest field a camera may see in a collection: its wide plate's
+    (``Collection.widest_field``), or None where it has none (or cannot say: a test double)."""
+    return getattr(collection, "widest_field", None)
+
+
 def camera_geometry(collection, camera) -> dict | None:
     """Where the camera sees less than the collection's field: its field and window, as
     recorded in results.json (``camera_geometry``) and in the sweep cache key; None for a
@@ -27,7 +33,7 @@ def camera_geometry(collection, camera) -> dict | None:
     from benchmark.camera.pipeline import camera_window
 
     field = collection_field(collection)
-    return geometry_record(camera, field, camera_window(camera, field))
+    return geometry_record(camera, field, camera_window(camera, field, collection_widest_field(collection)))
 
 
 def geometry_record(camera, field, window) -> dict | None:

@@ -244,7 +244,7 @@ def run_factors(collection, cameras, out_dir, *, base_name: str = "night", which
     from benchmark.camera.pipeline import lens_mapping
     from benchmark.detectors.registry import resolve_model, verify_sha256
     from benchmark.experiments.keys import factor_unit_key
-    from benchmark.experiments.collection_view import collection_field
+    from benchmark.experiments.collection_view import collection_field, collection_widest_field
     from benchmark.experiments.subset import parse_subset
     from metricscenes.backends import map_units, threads_per_unit
     from metricscenes.store import scale_groundtruth
@@ -294,7 +294,7 @@ def run_factors(collection, cameras, out_dir, *, base_name: str = "night", which
     kept = {s.image_id for s in scenes}
     per_camera = {}
     for camera in cameras:
-        window, to_sensor = lens_mapping(camera, field)
+        window, to_sensor = lens_mapping(camera, field, collection_widest_field(collection))
         gt = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px, field=field,
                                window=window, to_sensor=to_sensor)
         gt["images"] = [im for im in gt["images"] if im["id"] in kept]

@@ -43,7 +43,8 @@ import numpy as np
 
 from benchmark.detectors.policy import parse_input_size
 from benchmark.experiments.keys import capture_key, grid_key, results_capture_key, resume_key
-from benchmark.experiments.collection_view import COMPOSITE, collection_field, condition_spec, geometry_record
+from benchmark.experiments.collection_view import (COMPOSITE, collection_field, collection_widest_field, condition_spec,
+                                                   geometry_record)
 from benchmark.experiments.run_folder import (  # noqa: F401 (RESUMABLE_STAGE: named here too)
     CHECKPOINT, RESUMABLE_STAGE, link_or_copy, move_into_place, remove_stale_stages, resumable_stage,
 )
@@ -243,7 +244,8 @@ def run_cameras(collection, cameras, condition: str, detector, out_dirs, *, seed
     if len({d.resolve() for d in every}) != len(every):
         raise ValueError("run_cameras needs a distinct output folder per camera")
     field = collection_field(collection)
-    windows = [camera_window(camera, field) for camera in cameras]  # a camera wider than the collection: refused here
+    widest = collection_widest_field(collection)
+    windows = [camera_window(camera, field, widest) for camera in cameras]  # a camera wider than the collection: refused here
     captured = [None if c is None else read_captures(c, camera, condition, collection, seed)
                 for camera, c in zip(cameras, captures)]
     created = [[p for p in (d, *d.parents) if not p.exists()] for d in every]
@@ -458,7 +460,7 @@ class _CameraRun:
         from metricscenes.store import scale_groundtruth
 
         camera = self.camera
-        sensor_window, to_sensor = lens_mapping(camera, self.field)
+        sensor_window, to_sensor = lens_mapping(camera, self.field, collection_widest_field(self.collection))
         groundtruth = scale_groundtruth(self.collection.groundtruth(), camera.width_px, camera.height_px,
                                         field=self.field, window=sensor_window, to_sensor=to_sensor)
         return [self._write(groundtruth, detector, stage, detections)

@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import numpy as np
 import pandas as pd
 
-from benchmark.experiments.collection_view import collection_field
+from benchmark.experiments.collection_view import collection_field, collection_widest_field
 from benchmark.experiments.keys import results_key, run_key
 from benchmark.measure.mtf import MTF50_SOURCES, camera_mtf50
 from benchmark.result_files import OD50_COLUMNS, TABLE_COLUMNS  # noqa: F401 (the sweep's columns, named here too)
@@ -308,7 +308,7 @@ def sweep(collection, cameras: Iterable, conditions: Iterable[str], detector, ou
         raise ValueError(f"camera names must be unique, got {names}")
     field = collection_field(collection)
     for camera in cameras:  # every run folder name and camera field is valid before anything is written
-        camera_window(camera, field)
+        camera_window(camera, field, collection_widest_field(collection))
         for condition in conditions:
             run_name(camera.name, condition, tags[camera.name])
     check_scheduler(scheduler)

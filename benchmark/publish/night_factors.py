@@ -33,7 +33,7 @@ from benchmark.camera.exposure import parse_exposure, with_exposure
 from benchmark.camera.isp import encode_srgb8
 from benchmark.camera.pipeline import lens_mapping, simulate
 from benchmark.coco import coco_category_id
-from benchmark.experiments.collection_view import collection_field
+from benchmark.experiments.collection_view import collection_field, collection_widest_field
 from benchmark.experiments.run import scene_seed
 from benchmark.experiments.subset import subset_collection
 from benchmark.publish.night_exposure import green_sites
@@ -108,7 +108,7 @@ class SceneWeights:
 def run_variant(collection, scenes, weights: SceneWeights, base_camera, variant: Variant, detector, seed: int) -> dict:
     camera = variant_camera(base_camera, variant)
     field_ = collection_field(collection)
-    sensor_window, to_sensor = lens_mapping(camera, field_)
+    sensor_window, to_sensor = lens_mapping(camera, field_, collection_widest_field(collection))
     groundtruth = scale_groundtruth(collection.groundtruth(), camera.width_px, camera.height_px,
                                     field=field_, window=sensor_window, to_sensor=to_sensor)
     boxes = {a["image_id"]: a["bbox"] for a in groundtruth["annotations"]}

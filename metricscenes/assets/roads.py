@@ -125,8 +125,9 @@ def camera_lane_y_m(spec: RoadSpec, camera_lane: int = 0) -> float:
     return lane_center_y_m(spec, camera_lane, "same", camera_lane)
 
 
-def _line_rects(y: float, width: float, dashed: bool, dash: float, gap: float, phase: float) -> np.ndarray:
-    x0, x1 = ROAD_X_RANGE_M
+def _line_rects(y: float, width: float, dashed: bool, dash: float, gap: float, phase: float,
+                x_range: tuple[float, float] = ROAD_X_RANGE_M) -> np.ndarray:
+    x0, x1 = x_range
     if not dashed:
         return np.array([[x0, x1, y - width / 2, y + width / 2, MARKING_Z_M]])
     starts = np.arange(x0 - phase, x1, dash + gap)
@@ -136,13 +137,14 @@ def _line_rects(y: float, width: float, dashed: bool, dash: float, gap: float, p
                      np.full(keep.sum(), y + width / 2), np.full(keep.sum(), MARKING_Z_M)], 1)
 
 
-def _markings(spec: RoadSpec, yc: float, rng: np.random.Generator) -> dict[str, list[np.ndarray]]:
+def _markings(spec: RoadSpec, yc: float, rng: np.random.Generator,
+              x_range: tuple[float, float] = ROAD_X_RANGE_M) -> dict[str, list[np.ndarray]]:
     """Marking rectangles grouped by colour ('white', 'yellow')."""
     w, lw = spec.marking_width_m, spec.lane_width_m
     phase = rng.uniform(0, spec.dash_m + spec.gap_m)
     colour, pattern = spec.centre_style.split("_", 1)
     out: dict[str, list[np.ndarray]] = {"white": [], "yellow": []}
-    line = lambda y, dashed: _line_rects(y, w, dashed, spec.dash_m, spec.gap_m, phase)  # noqa: E731
+    line = lambda y, dashed: _line_rects(y, w, dashed, spec.dash_m, spec.gap_m, phase, x_range)  # noqa: E731
     if pattern == "double_solid":
         out[colour] += [line(yc - 1.5 * w, False), line(yc + 1.5 * w, False)]
     elif pattern == "solid_dashed":  # passing allowed from the camera's side
@@ -157,11 +159,12 @@ def _markings(spec: RoadSpec, yc: float, rng: np.random.Generator) -> dict[str, 
     return out
 
 
-def _segments(rng: np.random.Generator, y0: float, y1: float, z: float, mean_m: float) -> list[np.ndarray]:
+def _segments(rng: np.random.Generator, y0: float, y1: float, z: float, mean_m: float,
+              x_range: tuple[float, float] = ROAD_X_RANGE_M) -> list[np.ndarray]:
     """Paving segments along x with random lengths, as (rect, tone) rows."""
-    x, rows = ROAD_X_RANGE_M[0], []
-    while x < ROAD_X_RANGE_M[1]:
-        x_end = min(x + rng.uniform(0.5, 1.5) * mean_m, ROAD_X_RANGE_M[1])
+    x, rows = x_range[0], []
+    while x < x_range[1]:
+        x_end = min(x + rng.uniform(0.5, 1.5) * mean_m, x_range[1])
         rows.append(np.array([x, x_end, y0, y1, z, rng.integers(_TONES)], float))
         x = x_end
     return rows
@@ -194,28 +197,32 @@ def horizon_edge() -> meshes.Mesh:
     return v, np.array([[0, 1, 2], [0, 2, 3]])  # counter-clockwise seen from the camera (-x)
 
 
-def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_horizon: bool = False) -> SceneParts:
+def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_horizon: bool = False,
+               road_end_m: float | None = None) -> SceneParts:
     """All shapes and lamps of a road (keys 'road_*', 'tree_*', 'streetlight_*'), seeded.
 
     ``ground_to_horizon`` closes the strip between the far ground's edge and the camera's
-    horizontal (see :func:`horizon_edge`)."""
+    horizontal (see :func:`horizon_edge`). ``road_end_m``: where the detailed road (paving,
+    markings, terrain tiles, trees, street lights) ends ahead, beyond it the plain far road and
+    ground (None: ``ROAD_X_RANGE_M``'s end, the same shapes and draws as ever)."""
     rng = np.random.default_rng([_SALT, spec.road_id, int(seed)])
     yc = centre_line_y_m(spec, camera_lane)
     half_lanes, half_paved = spec.lanes_each_way * spec.lane_width_m, spec.half_paved_m
-    x0, x1 = ROAD_X_RANGE_M
+    x0, x1 = ROAD_X_RANGE_M[0], ROAD_X_RANGE_M[1] if road_end_m is None else float(road_end_m)
     # Asphalt: lanes of each direction and the shoulders are paved in separate segments.
-    rows = _segments(rng, yc - half_lanes, yc, 0.0, 40.0) + _segments(rng, yc, yc + half_lanes, 0.0, 40.0)
-    rows += _segments(rng, yc - half_paved, yc - half_lanes, 0.0, 60.0)
-    rows += _segments(rng, yc + half_lanes, yc + half_paved, 0.0, 60.0)
+    span = (x0, x1)
+    rows = _segments(rng, yc - half_lanes, yc, 0.0, 40.0, span) + _segments(rng, yc, yc + half_lanes, 0.0, 40.0, span)
+    rows += _segments(rng, yc - half_paved, yc - half_lanes, 0.0, 60.0, span)
+    rows += _segments(rng, yc + half_lanes, yc + half_paved, 0.0, 60.0, span)
     shapes = _toned_meshes("road_asphalt", rows, "asphalt", spec.asphalt_brightness, spec.asphalt_variation)
     if spec.patch_count:
-        px = rng.uniform(8.0, 300.0, spec.patch_count)
+        px = rng.uniform(8.0, x1 - 95.0, spec.patch_count)  # (300 m on the default road)
         py = rng.uniform(yc - half_lanes + 1.0, yc + half_lanes - 1.0, spec.patch_count)
         lx, ly = rng.uniform(1.5, 6.0, spec.patch_count), rng.uniform(0.8, 2.5, spec.patch_count)
         v, f = meshes.quads_z(np.stack([px, px + lx, py - ly / 2, py + ly / 2, np.full_like(px, PATCH_Z_M)], 1))
         patch_bsdf = diffuse_bsdf("asphalt", 0.75 * spec.asphalt_brightness)
         shapes["road_patches"] = mesh_shape("road_patches", v, f, patch_bsdf)
-    for colour, rects in _markings(spec, yc, rng).items():
+    for colour, rects in _markings(spec, yc, rng, span).items():
         if rects:
             v, f = meshes.quads_z(np.concatenate(rects))
             name = f"road_marking_{colour}"
@@ -243,7 +250,7 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_ho
         parts = parts.merged(tree_parts(rng, rows_t, spec.tree_spacing_m))
     # A distant tree line on both sides gives the horizon some structure on every road.
     far_rows = [(yc + 45.0, 1, 40.0), (yc - 45.0, -1, 40.0)]
-    parts = parts.merged(tree_parts(rng, far_rows, 12.0, x_range_m=(20.0, 395.0), prefix="tree_far"))
+    parts = parts.merged(tree_parts(rng, far_rows, 12.0, x_range_m=(20.0, x1), prefix="tree_far"))
     if spec.street_lights:
         side = 1.0 if spec.light_side == "left" else -1.0
         pole_y = yc + side * (half_paved + verge + 1.0)
