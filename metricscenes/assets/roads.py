@@ -206,23 +206,31 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_ho
     markings, terrain tiles, trees, street lights) ends ahead, beyond it the plain far road and
     ground (None: ``ROAD_X_RANGE_M``'s end, the same shapes and draws as ever)."""
     rng = np.random.default_rng([_SALT, spec.road_id, int(seed)])
+    # The road beyond the default's end draws from a stream of its own, so that a longer road is the
+    # default road, draw for draw, and more road (docs/scenes.md, "Distances beyond 200 m").
+    more_rng = np.random.default_rng([_SALT, spec.road_id, int(seed), 1])
     yc = centre_line_y_m(spec, camera_lane)
     half_lanes, half_paved = spec.lanes_each_way * spec.lane_width_m, spec.half_paved_m
-    x0, x1 = ROAD_X_RANGE_M[0], ROAD_X_RANGE_M[1] if road_end_m is None else float(road_end_m)
+    x0, x_default = ROAD_X_RANGE_M
+    x1 = x_default if road_end_m is None else float(road_end_m)
+    if x1 < x_default:
+        raise ValueError(f"road_end_m must be at least {x_default:g} m (the default road's end), got {x1:g}")
+    spans = [(rng, (x0, x_default))] + ([(more_rng, (x_default, x1))] if x1 > x_default else [])
     # Asphalt: lanes of each direction and the shoulders are paved in separate segments.
-    span = (x0, x1)
-    rows = _segments(rng, yc - half_lanes, yc, 0.0, 40.0, span) + _segments(rng, yc, yc + half_lanes, 0.0, 40.0, span)
-    rows += _segments(rng, yc - half_paved, yc - half_lanes, 0.0, 60.0, span)
-    rows += _segments(rng, yc + half_lanes, yc + half_paved, 0.0, 60.0, span)
+    rows = []
+    for draw, span in spans:
+        rows += _segments(draw, yc - half_lanes, yc, 0.0, 40.0, span) + _segments(draw, yc, yc + half_lanes, 0.0, 40.0, span)
+        rows += _segments(draw, yc - half_paved, yc - half_lanes, 0.0, 60.0, span)
+        rows += _segments(draw, yc + half_lanes, yc + half_paved, 0.0, 60.0, span)
     shapes = _toned_meshes("road_asphalt", rows, "asphalt", spec.asphalt_brightness, spec.asphalt_variation)
     if spec.patch_count:
-        px = rng.uniform(8.0, x1 - 95.0, spec.patch_count)  # (300 m on the default road)
+        px = rng.uniform(8.0, 300.0, spec.patch_count)
         py = rng.uniform(yc - half_lanes + 1.0, yc + half_lanes - 1.0, spec.patch_count)
         lx, ly = rng.uniform(1.5, 6.0, spec.patch_count), rng.uniform(0.8, 2.5, spec.patch_count)
         v, f = meshes.quads_z(np.stack([px, px + lx, py - ly / 2, py + ly / 2, np.full_like(px, PATCH_Z_M)], 1))
         patch_bsdf = diffuse_bsdf("asphalt", 0.75 * spec.asphalt_brightness)
         shapes["road_patches"] = mesh_shape("road_patches", v, f, patch_bsdf)
-    for colour, rects in _markings(spec, yc, rng, span).items():
+    for colour, rects in _markings(spec, yc, rng, (x0, x1)).items():  # (dashes follow from one phase)
         if rects:
             v, f = meshes.quads_z(np.concatenate(rects))
             name = f"road_marking_{colour}"
@@ -231,8 +239,8 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_ho
     shapes["road_far"] = mesh_shape("road_far", v, f, diffuse_bsdf("asphalt", spec.asphalt_brightness))
     # Terrain: 10 m x 10 m tiles in tone classes, a dirt verge strip, and the far ground.
     ys = np.arange(yc - TERRAIN_HALF_WIDTH_M, yc + TERRAIN_HALF_WIDTH_M, 10.0)
-    tiles = [np.array([x, x + 10.0, y, y + 10.0, TERRAIN_Z_M, rng.integers(_TONES)])
-             for x in np.arange(x0, x1, 10.0) for y in ys]
+    tiles = [np.array([x, x + 10.0, y, y + 10.0, TERRAIN_Z_M, draw.integers(_TONES)])
+             for draw, (a, b) in spans for x in np.arange(a, b, 10.0) for y in ys]
     shapes.update(_toned_meshes("road_terrain", tiles, spec.terrain, 1.0, 0.12))
     verge = rng.uniform(0.4, 1.2)
     v, f = meshes.quads_z([[x0, x1, yc - half_paved - verge, yc - half_paved, TERRAIN_Z_M / 2],
@@ -245,12 +253,17 @@ def road_parts(spec: RoadSpec, seed: int = 0, camera_lane: int = 0, ground_to_ho
         shapes["road_ground_edge"] = mesh_shape("road_ground_edge", *horizon_edge(), diffuse_bsdf(spec.terrain, 0.9))
     parts = SceneParts(shapes=shapes)
     margin = 1.5 + verge
+    far_rows = [(yc + 45.0, 1, 40.0), (yc - 45.0, -1, 40.0)]
     if spec.trees:
         rows_t = [(yc + half_paved + margin, 1, 20.0), (yc - half_paved - margin, -1, 20.0)]
         parts = parts.merged(tree_parts(rng, rows_t, spec.tree_spacing_m))
     # A distant tree line on both sides gives the horizon some structure on every road.
-    far_rows = [(yc + 45.0, 1, 40.0), (yc - 45.0, -1, 40.0)]
-    parts = parts.merged(tree_parts(rng, far_rows, 12.0, x_range_m=(20.0, x1), prefix="tree_far"))
+    parts = parts.merged(tree_parts(rng, far_rows, 12.0, x_range_m=(20.0, x_default), prefix="tree_far"))
+    if x1 > x_default:  # the trees of the road beyond, from its own stream
+        if spec.trees:
+            parts = parts.merged(tree_parts(more_rng, rows_t, spec.tree_spacing_m, x_range_m=(390.0, x1 - 5.0),
+                                            prefix="tree_more"))
+        parts = parts.merged(tree_parts(more_rng, far_rows, 12.0, x_range_m=(x_default, x1), prefix="tree_far_more"))
     if spec.street_lights:
         side = 1.0 if spec.light_side == "left" else -1.0
         pole_y = yc + side * (half_paved + verge + 1.0)
