@@ -19,6 +19,7 @@ plate's grid first, then interpolated as the plate is (docs/scenes.md, "The inse
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -58,13 +59,22 @@ class RadianceLayer:
 
 
 @dataclass(frozen=True)
+class LazyLayer:
+    """A layer read only when a grid needs it (a collection's wide plate: narrow cameras never
+    do): its extent is known without reading it."""
+
+    extent: TanExtent
+    read: Callable[[], RadianceLayer]
+
+
+@dataclass(frozen=True)
 class SpectralScene:
     """One scene's spectral radiance, ready for a camera.
 
     Attributes:
         layers: plate first, then insets (pasted in order).
         surround: a coarser plate over a wider field than the plate's (a collection's
-            ``wide_plate``), or None. Read only by a grid that reaches beyond the plate: the
+            ``wide_plate``; a :class:`LazyLayer` is read when first needed), or None. Read only by a grid that reaches beyond the plate: the
             plate is then pasted over it with a feather of :data:`PLATE_SEAM_FEATHER`, then
             the insets as ever; a grid inside the plate's field never reads it.
         wavelengths_nm: band centres, nm.
@@ -73,7 +83,7 @@ class SpectralScene:
     """
 
     layers: tuple[RadianceLayer, ...]
-    surround: RadianceLayer | None = None
+    surround: RadianceLayer | LazyLayer | None = None
     wavelengths_nm: np.ndarray = field(default_factory=lambda: WAVELENGTHS_NM.copy())
     units: str = RADIANCE_UNITS
     metadata: dict = field(default_factory=dict)
@@ -129,9 +139,10 @@ class SpectralScene:
             return self._last_resample[key]
         plate = self.layers[0]
         if self.surround is not None and not extent_within(extent, plate.extent):
-            surround = self.surround
+            surround = self._once(("surround",), lambda: self.surround.read() if isinstance(self.surround, LazyLayer)
+                                  else self.surround)
             out = _apply(*_weights(surround, cols, rows, extent),
-                         self._once(("surround",), lambda: band_planes(surround.radiance)))
+                         self._once(("surround planes",), lambda: band_planes(surround.radiance)))
             # (one feathered plate per scene: the once-cache keys it by its id)
             seam_plate = self._once(("seam plate",), lambda: replace(plate, feather=PLATE_SEAM_FEATHER))
             _paste(out, seam_plate, cols, rows, extent, surround.extent, once=self._once)

@@ -74,7 +74,7 @@ from metricscenes.groundtruth_checks import box_problem, groundtruth_problems, m
 from metricscenes.manifest import (
     Manifest, ManifestError, TargetedCondition, load_manifest, parse_illuminance_condition, parse_manifest,
 )
-from metricscenes.radiance import RadianceLayer, SpectralScene, car_sharpness, on_grid_of
+from metricscenes.radiance import LazyLayer, RadianceLayer, SpectralScene, car_sharpness, on_grid_of
 from metricscenes.records import ResolvedManifest
 from metricscenes.photometry import image_plane_illuminance_lux
 from metricscenes.targets import TargetedWeights, ambient_weight, draw_target_lux, solve_at_image_plane
@@ -562,17 +562,20 @@ class Collection:
             inset = replace(inset, sharp=car_sharpness(mask, inset.extent, plate.pixel_tan))
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
         surround = None
-        if self.manifest.wide_plate is not None:  # the wide plate, with the car lamps' light on its grid
-            env_unit = f"env{img['environment_id']:03d}"
-            surround = self._mix("wide_plates", env_unit, weights, scene_id)
-            wide_frame = self._mix("wide_frames", scene_id, weights, scene_id, required=False)
-            if wide_frame is not None:
-                surround = RadianceLayer(surround.radiance + on_grid_of(wide_frame, surround), surround.extent)
+        if self.manifest.wide_plate is not None:  # read only by a camera wider than the plate
+            surround = LazyLayer(self.manifest.wide_plate.field,
+                                 lambda: self._wide_plate(img["environment_id"], weights, scene_id))
         return SpectralScene(
             layers=layers, surround=surround,
             metadata={"scene_id": scene_id, "condition": condition, "distance_m": img["distance_m"],
                       "environment_id": img["environment_id"]},
         )
+
+    def _wide_plate(self, environment_id: int, weights: dict[str, float], scene_id: str) -> RadianceLayer:
+        """The scene's wide plate under ``weights``, with the car lamps' light on its grid."""
+        plate = self._mix("wide_plates", f"env{environment_id:03d}", weights, scene_id)
+        frame = self._mix("wide_frames", scene_id, weights, scene_id, required=False)
+        return plate if frame is None else RadianceLayer(plate.radiance + on_grid_of(frame, plate), plate.extent)
 
     def angular_sampling(self, scene_id: str) -> list[dict]:
         """Per layer (plate, inset): its extent in tangent coordinates and its sampling in mrad per pixel."""

@@ -73,10 +73,11 @@ def test_packaged_protocols_accept_the_packaged_manifests():
     from metricscenes.manifest import load_manifest
 
     protocols = load_protocols()
-    assert list(protocols) == ["metric-300", "quick", "smoke"]
+    assert list(protocols) == ["metric-300", "quick", "adas", "smoke"]
     for name, protocol in protocols.items():
-        m = load_manifest(REPO / "manifests" / f"{name}.yaml")
-        assert m.protocol == name
+        (collection,) = protocol.collection_names or (name,)  # the manifest that names the collection
+        m = load_manifest(REPO / "manifests" / f"{collection}.yaml")
+        assert m.protocol == name and m.name == collection
         assert m.sha256() in protocol.manifests_sha256, f"{name}: manifest sha256 is now {m.sha256()}"
         assert protocol.distances_m == tuple(m.distances_m)
         assert protocol.n_environments == m.environments

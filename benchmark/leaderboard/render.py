@@ -37,7 +37,7 @@ from benchmark.leaderboard.validate import SUBMISSIONS, duplicate_problem, read_
 from metricscenes.files import write_atomic
 
 REPRODUCE = """\
-for c in quick metric-300; do  # metric-300 takes hours on 2 cores (docs/performance.md)
+for c in quick adas-quick metric-300; do  # metric-300 takes hours on 2 cores (docs/performance.md)
   metricscenes generate --manifest manifests/$c.yaml --out collections/$c
   benchmark sweep --collection collections/$c --conditions day,dusk,night,night_regulation --model yolov5n-dynamic \\
       --out sweeps/$c --no-save-images

@@ -202,12 +202,36 @@ def collections_table(loaded: list[tuple[pd.DataFrame, pd.DataFrame]], names: tu
     return "\n".join(lines) + f"\n\nSpearman's ρ of the two orders ({len(cameras)} cameras): {_minus(f'{rho:.2f}')}"
 
 
+def mtf50_rho_table(table: pd.DataFrame, od50: pd.DataFrame) -> str:
+    """Per condition, Spearman's ρ across cameras of the OD50 against MTF50 (cy/mrad, in object
+    space): over the cameras whose OD50 is measured inside the distances, and over every camera
+    by the leaderboard's rank value (a censored OD50 by its tier and AP range); then ρ of the AP
+    range (area under AP vs distance) against MTF50, every camera."""
+    from benchmark.experiments.acceptance import _spearman
+
+    lines = [_row(["condition", "cameras", "OD50 measured", "ρ(OD50, MTF50), measured", "ρ(rank value, MTF50)",
+                   "ρ(AP range, MTF50)"]), _rule(6)]
+    for condition in [c for c in ("day", "dusk", *NIGHTS) if c in set(od50["condition"])]:
+        rows = od50[od50["condition"] == condition].set_index("camera")
+        ap = table[table["condition"] == condition].set_index(["camera", "distance_m"])["ap"]
+        measured = rows[(rows["censored"] == "") & np.isfinite(rows["od50_m"])]
+        value = pd.Series({camera: rank_value(rows.loc[camera], ap[camera]) for camera in rows.index})
+        ranges = pd.Series({camera: ap_range(list(ap[camera].index), list(ap[camera].values)) for camera in rows.index})
+        mtf = rows["mtf50_cy_per_mrad"]
+        rhos = (_spearman(measured["mtf50_cy_per_mrad"], measured["od50_m"]), _spearman(mtf, value[mtf.index]),
+                _spearman(mtf, ranges[mtf.index]))
+        lines.append(_row([condition, str(len(rows)), str(len(measured)),
+                           *("—" if np.isnan(rho) else _minus(f"{rho:.2f}") for rho in rhos)]))
+    return "\n".join(lines)
+
+
 def tables(data: Path, against: Path | None = None, names: tuple[str, str] = ("quick", "metric-300")) -> dict[str, str]:
     """The tables of docs/results.md that ``data`` (and ``against``) hold, by their headings."""
     table, od50 = _load(data, "")
     parts = {c: ap_table(table, od50, c) for c in ("day", "dusk", *NIGHTS) if c in set(table["condition"])}
     if set(NIGHTS) <= set(table["condition"]):
         parts["the nights side by side"] = three_nights_table(data)
+    parts["OD50 against MTF50"] = mtf50_rho_table(table, od50)
     if (data / "od50-native.csv").exists() and (data / "od50-640.csv").exists():
         parts["input size (day)"] = input_size_table(data)
     if (data / "od50-policies.csv").exists():
