@@ -511,7 +511,6 @@ def _checked_root_and_variant(manifest: Manifest, out_dir: str | Path, workers: 
     """:func:`check_before_writing`, also returning the variant it resolved (on a running
     cluster, resolving it is a round trip to one of its workers)."""
     from metricscenes.manifest import check_memory
-
     from metricscenes.scene_checks import farthest_scene_problems
 
     root = check_out_dir(out_dir)

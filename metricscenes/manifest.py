@@ -32,10 +32,10 @@ PLATE_LIGHT_GROUPS = ("sky_day", "sky_dusk", "sky_night", "street_lights", "ego_
 
 
 MAX_WEIGHT = 1e6
-# Road a car needs ahead of the camera beyond its distance: its own length (at most 5.5 m in the
-# library) and road seen behind it, so that no car stands at the detailed road's end.
-CAR_CLEARANCE_M = 20.0
 """Largest light-group weight of a condition (a weight of 1e300 would overflow float32 radiance)."""
+CAR_CLEARANCE_M = 20.0
+"""Road a car needs ahead of the camera beyond its distance: its own length (at most 5.5 m in the
+library) and road seen behind it, so that no car stands at the detailed road's end."""
 MAX_MANIFEST_BYTES = 1 << 20
 CONDITION_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 """A condition name becomes a folder name (``benchmark sweep``): no ``/``, no ``@`` (the
@@ -183,8 +183,8 @@ class RenderSettings(_Strict):
         "lost; unset: the car's box and margins only); see metricscenes.generate.inset_window and docs/scenes.md, "
         "'The car's shadow'")
     road_end_m: Float | None = Field(
-        None, ge=100.0, le=5000.0, description="where the detailed road ends ahead of the camera, metres: its "
-        "paving, markings, terrain tiles, trees and street lights (unset: 395 m); beyond it the plain far road and "
+        None, ge=395.0, le=5000.0, description="where the detailed road ends ahead of the camera, metres: its "
+        "paving, markings, terrain tiles, trees and street lights (unset: 395 m, the least); beyond it the plain far road and "
         "ground; see metricscenes.assets.roads.road_parts. Every distance must leave the car on it (Manifest)")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else llvm_ad_spectral where a libLLVM >= 17
     # renders, else scalar_spectral (metricscenes.render.resolve_variant; the variant used is recorded in

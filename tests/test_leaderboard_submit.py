@@ -218,7 +218,7 @@ def test_render_deterministic_and_ranked(app, populated, tmp_path):
         day = subs[name]["conditions"]["day"]
         assert f"[{name}](submissions/{name}.json)" in text
         assert f"{day['od50_m']:.1f} ± {day['od50_sd_m']:.1f}" in text
-    assert 'benchmark submit sweeps/$c --name "ref-{camera}-yolov5n-$c"' in text and 'for c in quick metric-300' in text
+    assert 'benchmark submit sweeps/$c --name "ref-{camera}-yolov5n-$c"' in text and 'for c in quick adas-quick metric-300' in text
     assert "http://" not in page.decode() and "https://" not in page.decode() and "src=" not in page.decode()
     # same inputs, same bytes: again, and in another folder
     other = tmp_path / "copy"
@@ -331,13 +331,13 @@ def test_committed_reference_submissions_are_valid_and_rendered():
                 warnings.simplefilter("error", NoDetectionsWarning)
                 data = check_submission_file(path)
             assert all(c["shipped_detections_sha256"] for c in data["conditions"].values())
-        assert data["collection"]["protocol"] in {"quick", "metric-300"}
+        assert data["collection"]["protocol"] in {"quick", "metric-300", "adas"}
     protocols = load_protocols(folder)
     submissions = load_submissions(folder, protocols)
     assert render_markdown(submissions, protocols) == (folder / "README.md").read_text()
     assert render_html(submissions, protocols) == (folder / "index.html").read_text()
     figures = band_figures(submissions, protocols)
-    assert sorted(figures) == ["metric-300", "quick"]
+    assert sorted(figures) == ["adas", "metric-300", "quick"]
     for name, svg in figures.items():
         assert (folder / f"references-{name}.svg").read_text() == svg
 

@@ -74,6 +74,10 @@ def test_the_adas_protocol_holds_at_its_farthest_distance():
     assert max(manifest.distances_m) == 600 and manifest.render.road_end_m == 700
     assert farthest_scene_problems(manifest) == []
     assert manifest.wide_plate.field.x1 == pytest.approx(np.tan(np.radians(60)))
+    full = load_manifest(ROOT / "manifests/adas-300.yaml")  # the full size: metric-300's environments
+    assert farthest_scene_problems(full) == [] and full.seed == load_manifest(ROOT / "manifests/metric-300.yaml").seed
+    on_axis_mrad = 1e3 * full.wide_plate.field.width / full.wide_plate.width_px
+    assert on_axis_mrad == pytest.approx(load_camera(ROOT / "cameras/adas-8mp-120deg.yaml").ifov_mrad, rel=0.01)
 
 
 def test_the_scene_checks_catch_each_failure():
@@ -157,6 +161,7 @@ def test_a_wide_collection_leaves_the_narrow_cameras_bytes_and_runs_wide_cameras
 
     from benchmark.detectors import load_detector
     from benchmark.experiments.run import run_camera
+    from benchmark.measure.seam import plate_seam_check
     from metricscenes.generate import generate
     from metricscenes.store import Collection
 
@@ -185,6 +190,10 @@ def test_a_wide_collection_leaves_the_narrow_cameras_bytes_and_runs_wide_cameras
         with Image.open(tmp_path / camera.name / "images/env000-d025m.png") as image:
             assert image.size == (camera.width_px, camera.height_px)
         assert result.camera_geometry.window_tan[2] == pytest.approx(camera.tan_half_width)
+        # The plate's border in its image (docs/scenes.md, "The wide plate"): the relative luminance step across
+        # it is the surround's and the plate's render noise at 4 spp (0.07; a surround 1.3 x too bright: 0.24).
+        seam = plate_seam_check(wide, "env000-d025m", "day_lamps", camera)
+        assert seam["step_luminance_max"] < 0.15, seam
 
 
 def test_a_longer_road_is_the_default_road_and_more():

@@ -95,3 +95,70 @@ def seam_check(collection: Collection, scene_id: str, condition: str, camera, in
             "window_de": float(de[background].mean()), "window_de_p99": float(np.percentile(de[background], 99)),
             "outside_de": float(de[~inside].mean()),
             "detail_ratio": detail(grad[0], grad[1]) / detail(grad[2], grad[3])}
+
+
+def plate_seam_check(collection: Collection, scene_id: str, condition: str, camera) -> dict:
+    """Does the reference plate's border show in a wide camera's image (a collection's
+    ``wide_plate``: docs/scenes.md, "The wide plate")? The scene is captured noise-free as the
+    store composites it, and its wide plate alone at the same exposure and white balance. Along
+    each of the plate's four edges, the mean L* step from a band just outside the plate to a band
+    just inside its feather ramp is measured on both images: the scene's own change across the
+    edge is in both, so their difference (``step_l``, per edge, and the largest) is what the seam
+    adds. ``inside_de``: the mean ΔE*ab between the two images over the inner bands (the two
+    plates' sampling and render noise)."""
+    from benchmark.camera.exposure import with_exposure
+    from benchmark.camera.pipeline import sensor_extent, simulate
+    from benchmark.camera.spec_exposure import ExposureSpec
+    from metricscenes.radiance import PLATE_SEAM_FEATHER, LazyLayer, SpectralScene
+
+    if camera.optics.distortion is not None:
+        raise ValueError(f"{camera.name}: the seam check maps the plate without lens distortion; choose another camera")
+    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
+    camera = camera.model_copy(update={"isp": isp})
+    scene = collection.radiance(scene_id, condition)
+    if scene.surround is None:
+        raise ValueError(f"{collection.root}: has no wide plate")
+    surround = scene.surround.read() if isinstance(scene.surround, LazyLayer) else scene.surround
+    composite = simulate(scene, camera, seed=0, noise=False)
+    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
+    alone = simulate(SpectralScene(layers=(surround,), wavelengths_nm=scene.wavelengths_nm), fixed, seed=0, noise=False)
+    lab_c, lab_s = srgb8_to_lab(composite.rgb8), srgb8_to_lab(alone.rgb8)
+    rows, cols = lab_c.shape[:2]
+    e, p = sensor_extent(camera, scene.extent), scene.extent  # the camera's grid, the plate's field
+    sx, sy = cols / e.width, rows / e.height
+    x0, x1, y0, y1 = (p.x0 - e.x0) * sx, (p.x1 - e.x0) * sx, (p.y0 - e.y0) * sy, (p.y1 - e.y0) * sy
+    if x0 <= SEAM_BAND_PX or y0 <= SEAM_BAND_PX:
+        raise ValueError(f"{camera.name}: sees no more than the reference plate's field on this collection")
+    rx, ry = PLATE_SEAM_FEATHER * (x1 - x0), PLATE_SEAM_FEATHER * (y1 - y0)
+    n = SEAM_BAND_PX
+    out_x0, in_x0 = int(np.floor(x0)) - SEAM_GAP_PX - n, int(np.ceil(x0 + rx)) + SEAM_GAP_PX
+    out_x1, in_x1 = int(np.ceil(x1)) + SEAM_GAP_PX, int(np.floor(x1 - rx)) - SEAM_GAP_PX - n
+    out_y0, in_y0 = int(np.floor(y0)) - SEAM_GAP_PX - n, int(np.ceil(y0 + ry)) + SEAM_GAP_PX
+    out_y1, in_y1 = int(np.ceil(y1)) + SEAM_GAP_PX, int(np.floor(y1 - ry)) - SEAM_GAP_PX - n
+    r0, r1, c0, c1 = int(np.ceil(y0 + ry)), int(np.floor(y1 - ry)), int(np.ceil(x0 + rx)), int(np.floor(x1 - rx))
+    edges = {  # (band outside, band inside), as index expressions
+        "left": ((slice(r0, r1), slice(out_x0, out_x0 + n)), (slice(r0, r1), slice(in_x0, in_x0 + n))),
+        "right": ((slice(r0, r1), slice(out_x1, out_x1 + n)), (slice(r0, r1), slice(in_x1, in_x1 + n))),
+        "top": ((slice(out_y0, out_y0 + n), slice(c0, c1)), (slice(in_y0, in_y0 + n), slice(c0, c1))),
+        "bottom": ((slice(out_y1, out_y1 + n), slice(c0, c1)), (slice(in_y1, in_y1 + n), slice(c0, c1))),
+    }
+    # Relative luminance (linear): where the two plates differ only in sharpness, their means agree in it.
+    lum_c, lum_s = (_relative_luminance(image.rgb8) for image in (composite, alone))
+    steps, relative, inner = {}, {}, []
+    for edge, (outside, inside) in edges.items():
+        step_c = lab_c[inside][..., 0].mean() - lab_c[outside][..., 0].mean()
+        step_s = lab_s[inside][..., 0].mean() - lab_s[outside][..., 0].mean()
+        steps[edge] = float(step_c - step_s)
+        relative[edge] = float((lum_c[inside].mean() - lum_c[outside].mean() - lum_s[inside].mean()
+                                + lum_s[outside].mean()) / lum_s[outside].mean())
+        inner.append(np.linalg.norm(lab_c[inside] - lab_s[inside], axis=-1).ravel())
+    return {"step_l": steps, "step_l_max": max(abs(v) for v in steps.values()),
+            "step_luminance": relative, "step_luminance_max": max(abs(v) for v in relative.values()),
+            "inside_de": float(np.concatenate(inner).mean())}
+
+
+def _relative_luminance(rgb8: np.ndarray) -> np.ndarray:
+    """Y of 8-bit sRGB (IEC 61966-2-1), linear, float64 (...)."""
+    c = rgb8.astype(np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return lin @ np.array([0.2126, 0.7152, 0.0722])
