@@ -44,6 +44,13 @@ def test_every_metric_300_table_row_of_the_results_page_comes_from_its_tables():
     assert not missing, f"docs/results.md lacks (or has other numbers in) {missing[:3]}"
 
 
+def test_every_adas_quick_table_row_of_the_results_page_comes_from_its_tables():
+    tables = results_page.tables(DATA / "adas-quick", against=DATA, names=("quick", "adas-quick"))
+    assert "day" in tables and "OD50 against MTF50" in tables and "day: adas-quick against quick" in tables
+    _, missing = _rows_missing_from_the_page(tables)
+    assert not missing, f"docs/results.md lacks (or has other numbers in) {missing[:3]}"
+
+
 @pytest.mark.parametrize("collection", ["quick", "metric-300"])
 def test_publish_lays_sweep_folders_out_as_docs_data(tmp_path, collection):
     results = tmp_path / "results"
