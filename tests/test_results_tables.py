@@ -51,6 +51,13 @@ def test_every_adas_quick_table_row_of_the_results_page_comes_from_its_tables():
     assert not missing, f"docs/results.md lacks (or has other numbers in) {missing[:3]}"
 
 
+def test_every_adas_camera_table_row_of_the_results_page_comes_from_its_tables():
+    tables = results_page.tables(DATA / "adas-quick-cameras")
+    assert set(tables) == {"day", "OD50 against MTF50"}
+    _, missing = _rows_missing_from_the_page(tables)
+    assert not missing, f"docs/results.md lacks (or has other numbers in) {missing[:3]}"
+
+
 @pytest.mark.parametrize("collection", ["quick", "metric-300"])
 def test_publish_lays_sweep_folders_out_as_docs_data(tmp_path, collection):
     results = tmp_path / "results"

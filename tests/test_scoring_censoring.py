@@ -165,8 +165,8 @@ def test_committed_leaderboard_shows_no_extrapolated_number():
 
     lb = REPO / "leaderboard"
     subs = load_submissions(lb, load_protocols(lb))
-    assert len(subs) == 2 * 13  # every committed submission still validates: 13 cameras on quick and on metric-300
-    assert {s["collection"]["protocol"] for s in subs} == {"quick", "metric-300"}
+    assert len(subs) == 3 * 13  # every committed submission still validates: 13 cameras on quick, adas and metric-300
+    assert {s["collection"]["protocol"] for s in subs} == {"quick", "adas", "metric-300"}
     text = render_markdown(subs, load_protocols(lb))
     assert "1625.6" not in text and "281.3" not in text and "\\> 200" in text and "(1000 resamples)" in text
     assert text == (lb / "README.md").read_text()  # regenerated with `benchmark leaderboard`
