@@ -19,7 +19,7 @@ import math
 import os
 import re
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator, model_validator
@@ -86,6 +86,7 @@ class ReferenceGrid(_Strict):
     the reference field (34.3° x 19.6°, the paper's 13 cameras) unless ``hfov_deg`` sets
     another horizontal field (the vertical one follows the grid's aspect)."""
 
+    _name: ClassVar[str] = "reference_grid"
     width_px: Int = Field(ge=16, le=8192)
     height_px: Int = Field(ge=9, le=4608)
     hfov_deg: Float | None = Field(
@@ -98,7 +99,7 @@ class ReferenceGrid(_Strict):
             raise ValueError("reference_grid must have the reference field's 16:9 aspect (e.g. 480 x 270) "
                              "unless it sets hfov_deg")
         if not 1.0 <= aspect <= 4.0:
-            raise ValueError(f"reference_grid aspect {aspect:.3g} must lie between 1 and 4")
+            raise ValueError(f"{self._name} aspect {aspect:.3g} must lie between 1 and 4")
         return self
 
     @property
@@ -114,15 +115,14 @@ WIDE_KINDS = ("wide_plates", "wide_frames")
 and the car lamps' frames on its grid (``wide_frames/<scene>/car_lights``)."""
 
 
-class WidePlate(_Strict):
+class WidePlate(ReferenceGrid):
     """A second, coarser plate around the reference grid's field, for cameras wider than it
     (docs/scenes.md, "The wide plate"): ``hfov_deg`` horizontally, the vertical field from the
     grid's aspect, rendered once per environment and light group at ``spp`` samples per pixel.
     A camera inside the reference field never reads it; a wider one sees the reference plate
     (and the car's inset) composited over it at its own sampling."""
 
-    width_px: Int = Field(ge=16, le=8192)
-    height_px: Int = Field(ge=9, le=8192)
+    _name: ClassVar[str] = "wide_plate"
     hfov_deg: Float = Field(ge=5.0, le=150.0, description="horizontal field of view, degrees")
     spp: Int = Field(ge=1, le=65536, description="samples per pixel")
 
@@ -130,20 +130,6 @@ class WidePlate(_Strict):
     @classmethod
     def _square(cls, value: int) -> int:
         return RenderSettings._square(value)
-
-    @model_validator(mode="after")
-    def _aspect(self) -> "WidePlate":
-        aspect = self.width_px / self.height_px
-        if not 1.0 <= aspect <= 4.0:
-            raise ValueError(f"wide_plate aspect {aspect:.3g} must lie between 1 and 4")
-        return self
-
-    @property
-    def field(self):
-        """The field the wide plate covers, in tangent coordinates."""
-        from metricscenes.geometry import field_extent
-
-        return field_extent(self.hfov_deg, self.width_px, self.height_px)
 
 
 AUTO_VARIANT = "auto"
