@@ -178,12 +178,13 @@ def test_a_wide_collection_leaves_the_narrow_cameras_bytes_and_runs_wide_cameras
     for scene in ("env000-d025m", "env000-d450m"):
         a, b = (c.radiance(scene, "day_lamps") for c in (narrow, wide))
         assert np.array_equal(a.resample(192, 108), b.resample(192, 108))
-    # A narrow camera: the same images and AP; a 37° x 24° and a 120° camera run uncropped.
+    # A narrow camera: the same images and AP; a 37° x 24° (16:10), a 120° (16:9) and a 100° (4:3) camera run uncropped.
     cam12 = load_camera("cam12")
     runs = {name: run_camera(c, cam12, "day_lamps", detector, tmp_path / name) for name, c in (("n", narrow), ("w", wide))}
     assert (tmp_path / "n/images.sha256").read_bytes() == (tmp_path / "w/images.sha256").read_bytes()
     assert [r.ap for r in runs["n"].per_distance] == [r.ap for r in runs["w"].per_distance]
-    for camera in (_camera("front-37", 960, 600, 3.0, pixel_um=4.2), _camera("wide-120", 1280, 720, 1.552)):
+    for camera in (_camera("front-37", 960, 600, 3.0, pixel_um=4.2), _camera("wide-120", 1280, 720, 1.552),
+                   _camera("wide-100-4x3", 640, 480, 1.128, pixel_um=4.2)):
         with pytest.raises(FieldOfViewError):
             run_camera(narrow, camera, "day", detector, tmp_path / f"{camera.name}-refused")
         result = run_camera(wide, camera, "day", detector, tmp_path / camera.name)
