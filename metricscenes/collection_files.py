@@ -176,7 +176,8 @@ def verify_collection(path: str | Path) -> list[str]:
         kind, _, rest = array_path.partition("/")
         unit = rest.split("/")[0]
         try:
-            read_checked(root, group, array_path, sha, f"environment {unit}" if kind in ("plates", "wide_plates") else f"scene {unit}",
+            where = f"environment {unit}" if kind in ("plates", "wide_plates") else f"scene {unit}"
+            read_checked(root, group, array_path, sha, where,
                          None if attributes is None else attributes.get(array_path, fallback))
         except CollectionError as exc:
             problems.append(str(exc))

@@ -170,8 +170,9 @@ class RenderSettings(_Strict):
         "'The car's shadow'")
     road_end_m: Float | None = Field(
         None, ge=395.0, le=5000.0, description="where the detailed road ends ahead of the camera, metres: its "
-        "paving, markings, terrain tiles, trees and street lights (unset: 395 m, the least); beyond it the plain far road and "
-        "ground; see metricscenes.assets.roads.road_parts. Every distance must leave the car on it (Manifest)")
+        "paving, markings, terrain tiles, trees and street lights (unset: 395 m, the least); beyond it the plain "
+        "far road and ground; see metricscenes.assets.roads.road_parts. Every distance must leave the car on it "
+        "(Manifest.detailed_road_end_m)")
     # "auto": cuda_ad_spectral where a CUDA device is usable, else llvm_ad_spectral where a libLLVM >= 17
     # renders, else scalar_spectral (metricscenes.render.resolve_variant; the variant used is recorded in
     # manifest.resolved.yaml). Not the default: the default is part of every manifest's sha256.
@@ -484,10 +485,9 @@ class Manifest(_Strict):
 
     @model_validator(mode="after")
     def _scene_holds(self) -> "Manifest":
-        from metricscenes.assets.roads import ROAD_X_RANGE_M
         from metricscenes.geometry import extent_within
 
-        road_end = self.render.road_end_m or ROAD_X_RANGE_M[1]
+        road_end = self.detailed_road_end_m
         farthest = max(self.distances_m)
         if farthest + CAR_CLEARANCE_M > road_end:
             raise ValueError(f"distances_m: a car at {farthest:g} m stands beyond the detailed road, which ends at "
@@ -547,17 +547,26 @@ class Manifest(_Strict):
             mixed |= {sweep.ambient_group, *sweep.lamps_on}
         return tuple(g for g in self.light_groups if g in mixed)
 
+    @property
+    def detailed_road_end_m(self) -> float:
+        """Where the detailed road ends ahead: ``render.road_end_m``, or the default road's end."""
+        from metricscenes.assets.roads import ROAD_X_RANGE_M
+
+        return self.render.road_end_m or ROAD_X_RANGE_M[1]
+
     def frame_grid_px(self) -> tuple[int, int]:
         """(width, height) of the car lamps' whole frame: the reference grid, or it divided
         by ``render.frame_divisor``."""
-        divisor = self.render.frame_divisor or 1
-        return self.reference_grid.width_px // divisor, self.reference_grid.height_px // divisor
+        return self._frame_of(self.reference_grid)
 
     def wide_frame_grid_px(self) -> tuple[int, int]:
         """(width, height) of the car lamps' frame on the wide plate's field: its grid, or it
         divided by ``render.frame_divisor``."""
+        return self._frame_of(self.wide_plate)
+
+    def _frame_of(self, grid: ReferenceGrid) -> tuple[int, int]:
         divisor = self.render.frame_divisor or 1
-        return self.wide_plate.width_px // divisor, self.wide_plate.height_px // divisor
+        return grid.width_px // divisor, grid.height_px // divisor
 
     def sha256(self) -> str:
         """Hash of the canonical JSON form: identifies what a collection was made from."""
@@ -634,8 +643,8 @@ def canonical_sha256(data) -> str:
 # Fields added after collections were first published (paths into the manifest's JSON
 # form), omitted from the hash while unset so that every earlier manifest keeps its
 # sha256 (pinned by protocols and collections).
-HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("wide_plate",), ("render", "road_end_m"), ("render", "inset_feather"),
-                        ("render", "ground_to_horizon"), ("render", "frame_divisor"), ("store", "mantissa_bits"),
+HASHED_ONLY_WHEN_SET = (("reference_grid", "hfov_deg"), ("store",), ("wide_plate",), ("render", "road_end_m"),
+                        ("render", "inset_feather"), ("render", "ground_to_horizon"), ("render", "frame_divisor"), ("store", "mantissa_bits"),
                         ("store", "spectral_basis"), ("render", "plate_lamp"), ("render", "rear_retroreflectors"),
                         ("render", "inset_shadow"))
 

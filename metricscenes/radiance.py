@@ -74,9 +74,10 @@ class SpectralScene:
     Attributes:
         layers: plate first, then insets (pasted in order).
         surround: a coarser plate over a wider field than the plate's (a collection's
-            ``wide_plate``; a :class:`LazyLayer` is read when first needed), or None. Read only by a grid that reaches beyond the plate: the
-            plate is then pasted over it with a feather of :data:`PLATE_SEAM_FEATHER`, then
-            the insets as ever; a grid inside the plate's field never reads it.
+            ``wide_plate``; a :class:`LazyLayer` is read when first needed), or None. Read only
+            by a grid that reaches beyond the plate: the plate is then pasted over it with a
+            feather of :data:`PLATE_SEAM_FEATHER`, then the insets as ever; a grid inside the
+            plate's field never reads it.
         wavelengths_nm: band centres, nm.
         units: radiance units (always ``W sr-1 m-2 nm-1``).
         metadata: free-form facts (scene id, condition, distance_m, ...).
@@ -109,6 +110,12 @@ class SpectralScene:
         """The widest field a camera may see: the surround's where there is one, else the plate's."""
         return self.extent if self.surround is None else self.surround.extent
 
+    def surround_layer(self) -> RadianceLayer | None:
+        """The surround as a layer: read (once per scene) where it is a :class:`LazyLayer`."""
+        if isinstance(self.surround, LazyLayer):
+            return self._once(("surround",), self.surround.read)
+        return self.surround
+
     @classmethod
     def uniform(
         cls, spectral_radiance: np.ndarray, rows: int = 8, cols: int = 8, **metadata
@@ -139,8 +146,7 @@ class SpectralScene:
             return self._last_resample[key]
         plate = self.layers[0]
         if self.surround is not None and not extent_within(extent, plate.extent):
-            surround = self._once(("surround",), lambda: self.surround.read() if isinstance(self.surround, LazyLayer)
-                                  else self.surround)
+            surround = self.surround_layer()
             out = _apply(*_weights(surround, cols, rows, extent),
                          self._once(("surround planes",), lambda: band_planes(surround.radiance)))
             # (one feathered plate per scene: the once-cache keys it by its id)

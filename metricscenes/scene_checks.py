@@ -17,10 +17,10 @@ from __future__ import annotations
 import numpy as np
 
 from metricscenes.assets import roads
-from metricscenes.geometry import extent_within, TanExtent
+from metricscenes.geometry import TanExtent, extent_within
 from metricscenes.groundtruth import car_box_tan
 from metricscenes.manifest import Manifest
-from metricscenes.plan import ScenePlan, plan_environment
+from metricscenes.plan import ScenePlan, plan_collection
 
 # A box must span at least this many reference-grid pixels each way: below it the box is a
 # point, not a car (the reference grid is what ground truth is written on).
@@ -39,14 +39,14 @@ def scene_problems(manifest: Manifest, scene: ScenePlan) -> list[str]:
     vertices = scene_mod.car_vertices(env, pose)
     grid = manifest.reference_grid
     pitch_x, pitch_y = grid.field.width / grid.width_px, grid.field.height / grid.height_px
-    road_end = manifest.render.road_end_m or roads.ROAD_X_RANGE_M[1]
+    road_end = manifest.detailed_road_end_m
     where = f"{scene.scene_id} (car {env.car_id}, road {env.road_id}, {scene.distance_m:g} m)"
     problems = []
     ground = vertices[vertices[:, 2] <= vertices[:, 2].min() + 0.05]  # the car's lowest points: its tyres
-    yc = roads.centre_line_y_m(road)
-    if np.abs(ground[:, 1] - yc).max() > road.half_paved_m or ground[:, 0].max() > road_end:
+    off_centre = float(np.abs(ground[:, 1] - roads.centre_line_y_m(road)).max())
+    if off_centre > road.half_paved_m or ground[:, 0].max() > road_end:
         problems.append(f"{where}: the car's wheels leave the paved road (|y - centre| up to "
-                        f"{np.abs(ground[:, 1] - yc).max():.2f} m of {road.half_paved_m:.2f} m, x up to "
+                        f"{off_centre:.2f} m of {road.half_paved_m:.2f} m, x up to "
                         f"{ground[:, 0].max():.1f} m of {road_end:g} m)")
     x0, y0, x1, y1 = car_box_tan(vertices)
     if not extent_within(TanExtent(x0, y0, x1, y1), grid.field):
@@ -64,9 +64,5 @@ def scene_problems(manifest: Manifest, scene: ScenePlan) -> list[str]:
 def farthest_scene_problems(manifest: Manifest) -> list[str]:
     """:func:`scene_problems` of every environment's scene at the manifest's farthest distance."""
     farthest = max(manifest.distances_m)
-    k = manifest.distances_m.index(farthest)
-    out = []
-    for e in range(manifest.environments):
-        env = plan_environment(manifest, e)
-        out += scene_problems(manifest, ScenePlan(env, float(farthest), image_id=0, seed=k))
-    return out
+    return [problem for scene in plan_collection(manifest) if scene.distance_m == farthest
+            for problem in scene_problems(manifest, scene)]

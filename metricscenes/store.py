@@ -552,10 +552,7 @@ class Collection:
         img = self._image(scene_id)
         weights = self._weights(condition, scene_id)
         mask, _ = self.mask(scene_id)  # a scene is read whole or not at all: its mask and box too
-        plate = self._mix("plates", f"env{img['environment_id']:03d}", weights, scene_id)
-        frame = self._mix("frames", scene_id, weights, scene_id, required=False)
-        if frame is not None:
-            plate = RadianceLayer(plate.radiance + on_grid_of(frame, plate), plate.extent)
+        plate = self._plate_with_frame("plates", "frames", img["environment_id"], weights, scene_id)
         inset = replace(self._mix("insets", scene_id, weights, scene_id),
                         feather=self.manifest.render.inset_feather or 0.0)
         if inset_resolution == "car" and mask.shape == inset.radiance.shape[:2]:
@@ -563,18 +560,20 @@ class Collection:
         layers = tuple(layer for layer in (plate, inset) if layer is not None)
         surround = None
         if self.manifest.wide_plate is not None:  # read only by a camera wider than the plate
-            surround = LazyLayer(self.manifest.wide_plate.field,
-                                 lambda: self._wide_plate(img["environment_id"], weights, scene_id))
+            surround = LazyLayer(self.manifest.wide_plate.field, lambda: self._plate_with_frame(
+                "wide_plates", "wide_frames", img["environment_id"], weights, scene_id))
         return SpectralScene(
             layers=layers, surround=surround,
             metadata={"scene_id": scene_id, "condition": condition, "distance_m": img["distance_m"],
                       "environment_id": img["environment_id"]},
         )
 
-    def _wide_plate(self, environment_id: int, weights: dict[str, float], scene_id: str) -> RadianceLayer:
-        """The scene's wide plate under ``weights``, with the car lamps' light on its grid."""
-        plate = self._mix("wide_plates", f"env{environment_id:03d}", weights, scene_id)
-        frame = self._mix("wide_frames", scene_id, weights, scene_id, required=False)
+    def _plate_with_frame(self, plate_kind: str, frame_kind: str, environment_id: int, weights: dict[str, float],
+                          scene_id: str) -> RadianceLayer:
+        """The scene's plate (``plates`` or ``wide_plates``) under ``weights``, with the car lamps'
+        light of its frame (``frames`` or ``wide_frames``) on its grid."""
+        plate = self._mix(plate_kind, f"env{environment_id:03d}", weights, scene_id)
+        frame = self._mix(frame_kind, scene_id, weights, scene_id, required=False)
         return plate if frame is None else RadianceLayer(plate.radiance + on_grid_of(frame, plate), plate.extent)
 
     def angular_sampling(self, scene_id: str) -> list[dict]:

@@ -17,10 +17,15 @@ SEAM_BAND_PX = 3  # band width, camera pixels
 SEAM_GAP_PX = 1  # pixels left out inward of the feather ramp's end
 
 
+def _srgb8_to_linear(rgb8: np.ndarray) -> np.ndarray:
+    """Linear RGB of 8-bit sRGB (IEC 61966-2-1), float64 (..., 3)."""
+    c = rgb8.astype(np.float64) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
 def srgb8_to_lab(rgb8: np.ndarray) -> np.ndarray:
     """CIELAB (D65 white) of 8-bit sRGB (IEC 61966-2-1), float64 (..., 3)."""
-    c = rgb8.astype(np.float64) / 255.0
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    lin = _srgb8_to_linear(rgb8)
     m = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]])
     xyz = lin @ m.T / np.array([0.95047, 1.0, 1.08883])
     f = np.where(xyz > (6 / 29) ** 3, np.cbrt(xyz), xyz / (3 * (6 / 29) ** 2) + 4 / 29)
@@ -35,22 +40,15 @@ def seam_check(collection: Collection, scene_id: str, condition: str, camera, in
     background (pixels farther from the car than :func:`metricscenes.radiance.car_sharpness`
     keeps sharp: mean and 99th percentile); and the detail ratio there, mean |∇L*| of the
     composite over the plate's (1: as sharp as the plate)."""
-    from benchmark.camera.exposure import with_exposure
-    from benchmark.camera.pipeline import sensor_extent, simulate
-    from benchmark.camera.spec_exposure import ExposureSpec
-    from metricscenes.radiance import SpectralScene, _overlap_matrix, car_sharpness
+    from benchmark.camera.pipeline import sensor_extent
+    from metricscenes.radiance import _overlap_matrix, car_sharpness
 
     if camera.optics.distortion is not None:
         raise ValueError(f"{camera.name}: the seam check maps the window without lens distortion; "
                          "choose another camera")
-    # One white balance for both images (grey world would follow the car's few pixels).
-    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
-    camera = camera.model_copy(update={"isp": isp})
     scene = collection.radiance(scene_id, condition, inset_resolution=inset_resolution)
     plate, inset = scene.layers[0], scene.layers[1]
-    composite = simulate(scene, camera, seed=0, noise=False)
-    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
-    alone = simulate(SpectralScene(layers=(plate,)), fixed, seed=0, noise=False)
+    composite, alone = _noise_free_pair(camera, scene, plate)
     lab_c, lab_p = srgb8_to_lab(composite.rgb8), srgb8_to_lab(alone.rgb8)
     de = np.linalg.norm(lab_c - lab_p, axis=-1)
     # The window on the camera's grid, and its background: wholly inside, away from the car.
@@ -106,22 +104,15 @@ def plate_seam_check(collection: Collection, scene_id: str, condition: str, came
     edge is in both, so their difference (``step_l``, per edge, and the largest) is what the seam
     adds. ``inside_de``: the mean ΔE*ab between the two images over the inner bands (the two
     plates' sampling and render noise)."""
-    from benchmark.camera.exposure import with_exposure
-    from benchmark.camera.pipeline import sensor_extent, simulate
-    from benchmark.camera.spec_exposure import ExposureSpec
-    from metricscenes.radiance import PLATE_SEAM_FEATHER, LazyLayer, SpectralScene
+    from benchmark.camera.pipeline import sensor_extent
+    from metricscenes.radiance import PLATE_SEAM_FEATHER
 
     if camera.optics.distortion is not None:
         raise ValueError(f"{camera.name}: the seam check maps the plate without lens distortion; choose another camera")
-    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
-    camera = camera.model_copy(update={"isp": isp})
     scene = collection.radiance(scene_id, condition)
     if scene.surround is None:
         raise ValueError(f"{collection.root}: has no wide plate")
-    surround = scene.surround.read() if isinstance(scene.surround, LazyLayer) else scene.surround
-    composite = simulate(scene, camera, seed=0, noise=False)
-    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
-    alone = simulate(SpectralScene(layers=(surround,), wavelengths_nm=scene.wavelengths_nm), fixed, seed=0, noise=False)
+    composite, alone = _noise_free_pair(camera, scene, scene.surround_layer())
     lab_c, lab_s = srgb8_to_lab(composite.rgb8), srgb8_to_lab(alone.rgb8)
     rows, cols = lab_c.shape[:2]
     e, p = sensor_extent(camera, scene.extent), scene.extent  # the camera's grid, the plate's field
@@ -159,6 +150,21 @@ def plate_seam_check(collection: Collection, scene_id: str, condition: str, came
 
 def _relative_luminance(rgb8: np.ndarray) -> np.ndarray:
     """Y of 8-bit sRGB (IEC 61966-2-1), linear, float64 (...)."""
-    c = rgb8.astype(np.float64) / 255.0
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-    return lin @ np.array([0.2126, 0.7152, 0.0722])
+    return _srgb8_to_linear(rgb8) @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def _noise_free_pair(camera, scene, alone):
+    """The scene and its layer ``alone`` by itself, captured noise-free by ``camera`` with one white
+    balance (the known illuminant: grey world would follow the car's few pixels) at the scene's
+    exposure: (the scene's capture, the layer's capture)."""
+    from benchmark.camera.exposure import with_exposure
+    from benchmark.camera.pipeline import simulate
+    from benchmark.camera.spec_exposure import ExposureSpec
+    from metricscenes.radiance import SpectralScene
+
+    isp = camera.isp.model_copy(update={"white_balance": "known_illuminant"})
+    camera = camera.model_copy(update={"isp": isp})
+    composite = simulate(scene, camera, seed=0, noise=False)
+    fixed = with_exposure(camera, ExposureSpec(mode="fixed", exposure_s=composite.exposure_s))
+    return composite, simulate(SpectralScene(layers=(alone,), wavelengths_nm=scene.wavelengths_nm), fixed, seed=0,
+                               noise=False)
